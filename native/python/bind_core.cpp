@@ -1,0 +1,69 @@
+// Errors and ExecContext: the pieces every binding area shares.
+#include <pybind11/pybind11.h>
+
+#include "exsynth/errors.hpp"
+#include "exsynth/exec_context.hpp"
+#include "exsynth/memory_budget.hpp"
+
+namespace py = pybind11;
+
+namespace exsynth::py_bind {
+namespace {
+
+// Created once at import; live as long as the interpreter.
+PyObject* g_error = nullptr;
+PyObject* g_invalid = nullptr;
+PyObject* g_budget = nullptr;
+PyObject* g_cancelled = nullptr;
+
+PyObject* new_exception(py::module_& m, const char* name, py::handle bases, const char* doc) {
+  const std::string qualified = std::string("exsynth._native.") + name;
+  PyObject* cls = PyErr_NewExceptionWithDoc(qualified.c_str(), doc, bases.ptr(), nullptr);
+  if (!cls) throw py::error_already_set();
+  m.add_object(name, py::handle(cls));  // add_object steals nothing: keep our reference
+  return cls;
+}
+
+}  // namespace
+
+void bind_core(py::module_& m) {
+  g_error = new_exception(m, "Error", PyExc_RuntimeError, "Base class of every exsynth engine error.");
+  g_invalid = new_exception(m, "InvalidInputError", py::make_tuple(py::handle(g_error), py::handle(PyExc_ValueError)),
+                            "An argument is malformed; the message names it and says what to change.");
+  g_budget = new_exception(m, "OverBudgetError", py::make_tuple(py::handle(g_error), py::handle(PyExc_MemoryError)),
+                           "The job would need more memory than its budget (checked before allocating).");
+  g_cancelled = new_exception(m, "CancelledError", py::handle(g_error), "The job was cancelled through its ExecContext.");
+
+  // One C++ class -> one Python class; nothing is swallowed.
+  py::register_exception_translator([](std::exception_ptr p) {
+    try {
+      if (p) std::rethrow_exception(p);
+    } catch (const InvalidInput& e) {
+      PyErr_SetString(g_invalid, e.what());
+    } catch (const OverBudget& e) {
+      PyErr_SetString(g_budget, e.what());
+    } catch (const Cancelled& e) {
+      PyErr_SetString(g_cancelled, e.what());
+    } catch (const Error& e) {
+      PyErr_SetString(g_error, e.what());
+    }
+  });
+
+  py::class_<ExecContext>(m, "ExecContext",
+                          "Progress (0..1), stage name and cancel flag of a running job; thread-safe.\n"
+                          "Pass it as ctx= to a long call running on a worker thread, read progress\n"
+                          "and stage from the UI thread, call cancel() to stop the job.")
+      .def(py::init<>())
+      .def("cancel", &ExecContext::cancel, "Ask the running job to stop; it raises CancelledError.")
+      .def_property_readonly("cancelled", &ExecContext::cancelled)
+      .def_property_readonly("progress", &ExecContext::progress)
+      .def_property_readonly("stage", &ExecContext::stage)
+      .def("__repr__", [](const ExecContext& c) {
+        return "<ExecContext stage='" + c.stage() + "' progress=" + std::to_string(c.progress()) +
+               (c.cancelled() ? " cancelled>" : ">");
+      });
+
+  m.attr("DEFAULT_MEMORY_BUDGET") = py::int_(kDefaultMemoryBudget);
+}
+
+}  // namespace exsynth::py_bind

@@ -1,0 +1,18 @@
+// exsynth._native: bindings only. Each area registers itself; see
+// docs/python_api.md for the Python-side contract.
+#include <pybind11/pybind11.h>
+
+namespace py = pybind11;
+
+namespace exsynth::py_bind {
+void bind_core(py::module_& m);
+void bind_voxel(py::module_& m);
+void bind_grid(py::module_& m);
+}  // namespace exsynth::py_bind
+
+PYBIND11_MODULE(_native, m) {
+  m.doc() = "exsynth engine (C++): voxelization, volumes, isosurfaces. Arrays are NumPy, C order.";
+  exsynth::py_bind::bind_core(m);
+  exsynth::py_bind::bind_voxel(m);
+  exsynth::py_bind::bind_grid(m);
+}
