@@ -206,6 +206,35 @@ TEST_F(VdbIo, UnsupportedGridTypeIsRejected) {
   EXPECT_THROW(exsynth::read_vdb(file("int.vdb")), exsynth::InvalidInput);
 }
 
+TEST_F(VdbIo, TransformsThatDoNotFitOneBoxAreRejected) {
+  openvdb::initialize();
+  auto make = [](const std::string& name, openvdb::math::Transform::Ptr xf) {
+    auto g = openvdb::FloatGrid::create(0.0f);
+    g->tree().setValue(openvdb::Coord(0, 0, 0), 1.0f);
+    g->setName(name);
+    g->setTransform(xf);
+    return g;
+  };
+  auto stretched = openvdb::math::Transform::createLinearTransform(0.1);
+  stretched->postScale(openvdb::Vec3d(1.0, 2.0, 1.0));
+  openvdb::io::File f(file("stretched.vdb"));
+  f.write(openvdb::GridPtrVec{make("d", stretched)});
+  f.close();
+  try {
+    exsynth::read_vdb(file("stretched.vdb"));
+    FAIL() << "expected InvalidInput";
+  } catch (const exsynth::InvalidInput& e) {
+    EXPECT_TRUE(contains(e.what(), "non-uniform voxel")) << e.what();
+  }
+
+  openvdb::io::File g(file("mixed.vdb"));
+  g.write(openvdb::GridPtrVec{make("a", openvdb::math::Transform::createLinearTransform(0.1)),
+                              make("b", openvdb::math::Transform::createLinearTransform(0.2))});
+  g.close();
+  EXPECT_THROW(exsynth::read_vdb(file("mixed.vdb")), exsynth::InvalidInput);
+  EXPECT_EQ(exsynth::read_vdb(file("mixed.vdb"), {"b"}).at("b").transform().voxel_size, 0.2);
+}
+
 TEST_F(VdbIo, NonVdbFileIsInvalidInput) {
   {
     std::FILE* fp = std::fopen(file("junk.vdb").c_str(), "w");

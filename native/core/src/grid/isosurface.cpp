@@ -22,6 +22,11 @@ void check_options(const Volume& vol, const IsosurfaceOptions& opt) {
                        " does not exist; the volume has " + std::to_string(vol.channels()) +
                        " channel(s)");
   }
+  const double h = vol.transform().voxel_size;
+  if (!(h > 0.0) || !std::isfinite(h)) {
+    throw InvalidInput("isosurface: the volume's voxel size must be positive (got " +
+                       std::to_string(h) + ")");
+  }
   if (!std::isfinite(opt.isovalue)) throw InvalidInput("isosurface: the isovalue is not finite");
   if (!(opt.adaptivity >= 0.0 && opt.adaptivity <= 1.0)) {
     throw InvalidInput("isosurface: adaptivity must be in [0, 1] (got " +

@@ -34,7 +34,7 @@ openvdb::math::Transform::Ptr make_transform(const GridTransform& t) {
   // OpenVDB index coordinates are voxel centres, as ours are, so index 0
   // simply maps to the origin.
   auto xf = openvdb::math::Transform::createLinearTransform(t.voxel_size);
-  if (0) xf->postTranslate(openvdb::Vec3d(t.origin[0], t.origin[1], t.origin[2]));
+  xf->postTranslate(openvdb::Vec3d(t.origin[0], t.origin[1], t.origin[2]));
   return xf;
 }
 

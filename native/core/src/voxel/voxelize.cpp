@@ -100,27 +100,35 @@ VoxelizeResult voxelize(const TriangleMesh& input, const VoxelizeOptions& opt, E
   std::vector<float> cov[3];
   std::vector<std::uint8_t> votes(voxels, 0);
   std::size_t lines_total = 0;
-  for (int a = 0; a < 3; ++a) lines_total += std::size_t(n[(a + 1) % 3]) * n[(a + 2) % 3];
+  for (int a = 0; a < 3; ++a) lines_total += voxels / std::size_t(n[a]);
   StageProgress stab(ctx, "voxelize: ray parity", 0.05, 0.5, lines_total);
   for (int a = 0; a < 3; ++a) {
-    const int b = (a + 1) % 3, c = (a + 2) % 3;
+    // Enumerate lines with the smaller-stride axis fastest, so neighbouring
+    // lines write neighbouring memory (the scatter is the costly part).
+    const int p = a == 0 ? 1 : 0, q = a == 2 ? 1 : 2;
     cov[a].assign(voxels, 0.0f);
-    parallel_chunks(std::size_t(n[b]) * n[c], 16, stab, [&](std::size_t begin, std::size_t end) {
+    parallel_chunks(std::size_t(n[p]) * n[q], 16, stab, [&](std::size_t begin, std::size_t end) {
       std::vector<voxel::Crossing> xs;
       std::vector<float> line_cov(n[a]);
       std::vector<std::uint8_t> inside(n[a]);
       const float w = 1.0f / float(S * S);
+      float pos[3] = {0, 0, 0};
+      auto cast = [&](float jp, float jq) {
+        pos[p] = jp;
+        pos[q] = jq;
+        caster.crossings(a, pos[(a + 1) % 3], pos[(a + 2) % 3], xs);
+      };
       for (std::size_t line = begin; line < end; ++line) {
-        const int jb = int(line % n[b]), jc = int(line / n[b]);
+        const int jp = int(line % n[p]), jq = int(line / n[p]);
         std::fill(line_cov.begin(), line_cov.end(), 0.0f);
-        for (int sb = 0; sb < S; ++sb)
-          for (int sc = 0; sc < S; ++sc) {
-            caster.crossings(a, jb + (sb + 0.5f) / S - 0.5f, jc + (sc + 0.5f) / S - 0.5f, xs);
+        for (int sp = 0; sp < S; ++sp)
+          for (int sq = 0; sq < S; ++sq) {
+            cast(jp + (sp + 0.5f) / S - 0.5f, jq + (sq + 0.5f) / S - 0.5f);
             voxel::accumulate_coverage(xs, n[a], w, line_cov.data());
           }
-        caster.crossings(a, float(jb), float(jc), xs);
+        cast(float(jp), float(jq));
         voxel::centre_parity(xs, n[a], inside.data());
-        const std::size_t base = jb * stride[b] + jc * stride[c];
+        const std::size_t base = jp * stride[p] + jq * stride[q];
         for (int i = 0; i < n[a]; ++i) {
           cov[a][base + i * stride[a]] = std::min(1.0f, line_cov[i]);
           votes[base + i * stride[a]] += inside[i];

@@ -1,0 +1,4 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
+"""Conversions between Blender data and the numpy arrays the engine works on."""
+
+CLASSES = ()
