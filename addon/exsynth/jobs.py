@@ -207,7 +207,7 @@ class JobOperator:
         try:
             job = self.make_job(context)
         except InputError as exc:
-            self.report({'ERROR'}, str(exc))
+            self.report({'ERROR'}, f"ExSynth {self.bl_label}: {exc}")
             return None
         return Runner(job)
 
@@ -215,10 +215,10 @@ class JobOperator:
         try:
             result = runner.outcome()
         except _native.CancelledError:
-            self.report({'WARNING'}, f"ExSynth: {runner.job.label} cancelled; the scene is unchanged")
+            self.report({'WARNING'}, f"ExSynth {self.bl_label}: cancelled; the scene is unchanged")
             return {'CANCELLED'}
         except REPORTED_ERRORS as exc:
-            self.report({'ERROR'}, f"ExSynth {runner.job.label}: {exc}")
+            self.report({'ERROR'}, f"ExSynth {self.bl_label}: {exc}")
             return {'CANCELLED'}
 
         created = Created()
@@ -226,7 +226,7 @@ class JobOperator:
             summary = self.finish(context, result, created)
         except REPORTED_ERRORS as exc:
             created.rollback()
-            self.report({'ERROR'}, f"ExSynth {runner.job.label}: {exc}")
+            self.report({'ERROR'}, f"ExSynth {self.bl_label}: {exc}")
             return {'CANCELLED'}
         except BaseException:
             created.rollback()

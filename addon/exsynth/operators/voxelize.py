@@ -1,0 +1,140 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
+"""Voxelize the active mesh: a Volume with `density` and `sdf` grids and,
+optionally, a mesh rebuilt from the voxels (the zero level of the sdf)."""
+
+import dataclasses
+
+import bpy
+import numpy as np
+
+from .. import _native
+from ..io import materials
+from ..io import mesh as mesh_io
+from ..io import volume as volume_io
+from ..jobs import InputError, Job, JobOperator
+
+
+@dataclasses.dataclass
+class Voxels:
+    """What a VoxelizeJob returns; arrays are indexed [z, y, x]."""
+
+    name: str
+    density: np.ndarray
+    sdf: np.ndarray
+    origin: np.ndarray  # world position of the centre of voxel [0, 0, 0]
+    voxel_size: float
+    surface: tuple = None  # (vertices V by 3, triangles F by 3) when make_mesh
+
+    @property
+    def dims_xyz(self):
+        return tuple(reversed(self.density.shape))
+
+
+@dataclasses.dataclass
+class VoxelizeJob(Job):
+    name: str
+    vertices: np.ndarray  # world space, V by 3
+    triangles: np.ndarray  # F by 3
+    resolution: int = 128
+    voxel_size: float = 0.0
+    padding: int = 2
+    supersample: int = 2
+    make_mesh: bool = True
+    memory_budget: int = 0  # bytes; 0 = the engine's default
+    seed: int = 0
+
+    label = "voxelize"
+
+    def run(self, ctx):
+        grids = _native.voxelize(
+            self.vertices, self.triangles,
+            resolution=self.resolution, voxel_size=self.voxel_size, padding=self.padding,
+            supersample=self.supersample, compute_sdf=True,
+            memory_budget=self.memory_budget, seed=self.seed, ctx=ctx,
+        )
+        voxels = Voxels(self.name, grids["density"], grids["sdf"], grids["origin"], grids["voxel_size"])
+        if self.make_mesh:
+            # The sdf is positive outside, so the isosurface's normals face out.
+            voxels.surface = _native.isosurface(
+                voxels.sdf, voxels.origin, voxels.voxel_size, isovalue=0.0, ctx=ctx
+            )
+        return voxels
+
+
+def source_triangles(obj, depsgraph):
+    """World-space triangles of `obj`, or an InputError saying what to select."""
+    if obj is None:
+        raise InputError(
+            "no active object. Select the mesh to voxelize (click it in the viewport or the "
+            "Outliner) and run Voxelize again"
+        )
+    if obj.type != 'MESH':
+        raise InputError(
+            f"the active object '{obj.name}' is a {obj.type.lower()}, not a mesh. "
+            "Select a mesh object and run Voxelize again"
+        )
+    verts, tris = mesh_io.world_triangles([obj], depsgraph)
+    if len(tris) == 0:
+        raise InputError(
+            f"the mesh '{obj.name}' has no faces (only vertices or edges), so it has no inside "
+            "to voxelize. Give it faces (Edit Mode, select, F) or select another mesh"
+        )
+    return verts, tris
+
+
+def add_voxel_objects(context, voxels, created):
+    """Volume object `<name>_voxels` (+ mesh `<name>_voxel_mesh`) in the active
+    collection, selected, the Volume active. Returns the new objects."""
+    collection = context.collection
+    path = volume_io.new_cache_path(f"{voxels.name}_voxels")
+    volume_io.write_vdb(
+        path, {"density": voxels.density, "sdf": voxels.sdf}, voxels.origin, voxels.voxel_size, created
+    )
+    vol_obj = volume_io.new_volume_object(f"{voxels.name}_voxels", path, collection, created)
+    vol_obj.data.materials.append(materials.volume_material(created))
+    new_objects = [vol_obj]
+    if voxels.surface is not None:
+        mesh = created.add(mesh_io.new_mesh(f"{voxels.name}_voxel_mesh", *voxels.surface, smooth=True))
+        mesh.materials.append(materials.surface_material(created))
+        mesh_obj = created.add(bpy.data.objects.new(mesh.name, mesh))
+        collection.objects.link(mesh_obj)
+        new_objects.append(mesh_obj)
+
+    for obj in list(context.view_layer.objects.selected):
+        obj.select_set(False)
+    for obj in new_objects:
+        obj.select_set(True)
+    context.view_layer.objects.active = vol_obj
+    return new_objects
+
+
+class EXSYNTH_OT_voxelize(JobOperator, bpy.types.Operator):
+    """Voxelize the active mesh into a Volume (density and signed-distance grids) and optionally a rebuilt mesh. Settings: ExSynth tab of the sidebar"""
+
+    bl_idname = "exsynth.voxelize"
+    bl_label = "Voxelize"
+    bl_options = {'REGISTER', 'UNDO'}
+
+    def make_job(self, context):
+        if context.mode != 'OBJECT':
+            raise InputError("works in Object Mode only. Press Tab to leave Edit Mode and run it again")
+        settings = context.scene.exsynth
+        obj = context.active_object
+        verts, tris = source_triangles(obj, context.evaluated_depsgraph_get())
+        return VoxelizeJob(
+            name=obj.name, vertices=verts, triangles=tris,
+            resolution=settings.resolution, padding=settings.padding,
+            supersample=settings.supersample, make_mesh=settings.make_mesh,
+            memory_budget=settings.memory_budget_bytes, seed=settings.seed,
+        )
+
+    def finish(self, context, voxels, created):
+        add_voxel_objects(context, voxels, created)
+        nx, ny, nz = voxels.dims_xyz
+        summary = f"ExSynth: voxelized '{voxels.name}' into {nx}×{ny}×{nz} voxels of {voxels.voxel_size:.4g}"
+        if voxels.surface is not None:
+            summary += f", mesh of {len(voxels.surface[1])} triangles"
+        return summary
+
+
+CLASSES = (EXSYNTH_OT_voxelize,)

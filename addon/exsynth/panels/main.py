@@ -1,0 +1,70 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
+"""The "ExSynth" tab in the 3D viewport's sidebar (N-panel)."""
+
+import math
+
+import bpy
+
+CATEGORY = "ExSynth"
+
+
+class EXSYNTH_PT_voxelize(bpy.types.Panel):
+    bl_label = "Voxelize"
+    bl_space_type = 'VIEW_3D'
+    bl_region_type = 'UI'
+    bl_category = CATEGORY
+
+    def draw(self, context):
+        layout = self.layout
+        layout.use_property_split = True
+        layout.use_property_decorate = False
+        settings = context.scene.exsynth
+
+        col = layout.column()
+        col.prop(settings, "resolution")
+        col.prop(settings, "padding")
+        col.prop(settings, "supersample")
+        col.prop(settings, "make_mesh")
+
+        obj = context.active_object
+        box = layout.box()
+        if obj is None or obj.type != 'MESH':
+            box.label(text="Select a mesh object", icon='INFO')
+        else:
+            box.label(text=obj.name, icon='MESH_DATA')
+            box.label(text=_grid_estimate(obj, settings))
+        row = layout.row()
+        row.scale_y = 1.4
+        row.operator("exsynth.voxelize", icon='VOLUME_DATA')
+
+
+class EXSYNTH_PT_voxelize_advanced(bpy.types.Panel):
+    bl_label = "Advanced"
+    bl_space_type = 'VIEW_3D'
+    bl_region_type = 'UI'
+    bl_category = CATEGORY
+    bl_parent_id = "EXSYNTH_PT_voxelize"
+    bl_options = {'DEFAULT_CLOSED'}
+
+    def draw(self, context):
+        layout = self.layout
+        layout.use_property_split = True
+        layout.use_property_decorate = False
+        settings = context.scene.exsynth
+        layout.prop(settings, "seed")
+        layout.prop(settings, "memory_budget_gib", text="Memory Budget (GiB)")
+
+
+def _grid_estimate(obj, settings):
+    # From the object's dimensions (scale included, rotation not), so the
+    # artist sees the grid size before starting; the engine computes the real one.
+    dims = obj.dimensions
+    longest = max(dims)
+    if longest <= 0:
+        return "Empty bounding box"
+    h = longest / settings.resolution
+    n = [math.ceil(d / h) + 2 * settings.padding for d in dims]
+    return f"about {n[0]} × {n[1]} × {n[2]} voxels"
+
+
+CLASSES = (EXSYNTH_PT_voxelize, EXSYNTH_PT_voxelize_advanced)
