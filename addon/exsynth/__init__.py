@@ -14,7 +14,6 @@ bl_info = {
     "blender": (3, 4, 0),
     "location": "View3D > Sidebar > ExSynth",
     "description": "Example-based texture and geometry synthesis (voxelize meshes into volumes)",
-    "doc_url": "",
     "category": "ExSynth",
 }
 

@@ -119,7 +119,8 @@ class Created:
         return path
 
     def rollback(self):
-        # Objects first (they use the data), then their data, in reverse order.
+        # Best effort throughout: the error that caused the rollback is the
+        # one the user needs to see, not a second one from cleaning up.
         alive = []
         for id_block in reversed(self.ids):
             try:

@@ -8,11 +8,13 @@ namespace exsynth::py_bind {
 void bind_core(py::module_& m);
 void bind_voxel(py::module_& m);
 void bind_grid(py::module_& m);
+void bind_solid(py::module_& m);
 }  // namespace exsynth::py_bind
 
 PYBIND11_MODULE(_native, m) {
-  m.doc() = "exsynth engine (C++): voxelization, volumes, isosurfaces. Arrays are NumPy, C order.";
+  m.doc() = "exsynth engine (C++): voxelization, volumes, isosurfaces, solid and 2D texture synthesis. Arrays are NumPy, C order.";
   exsynth::py_bind::bind_core(m);
   exsynth::py_bind::bind_voxel(m);
   exsynth::py_bind::bind_grid(m);
+  exsynth::py_bind::bind_solid(m);
 }

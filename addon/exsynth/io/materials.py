@@ -16,8 +16,8 @@ def volume_material(created):
     if mat is not None:
         return mat
     mat = created.add(bpy.data.materials.new(VOLUME_MATERIAL))
-    # Built by hand: use_nodes alone gives a Principled BSDF wired to Surface,
-    # which a Volume object cannot show.
+    # Nodes built by hand: what use_nodes creates depends on the active object
+    # (a Principled BSDF, or with a Volume active a Principled Volume).
     shader = _output_with(mat, "ShaderNodeVolumePrincipled", "Volume")
     shader.inputs["Density Attribute"].default_value = "density"  # the grid written by the add-on
     shader.inputs["Density"].default_value = 1.0  # per world unit, as Blender's own volume default
@@ -29,12 +29,17 @@ def surface_material(created):
     mat = bpy.data.materials.get(SURFACE_MATERIAL)
     if mat is not None:
         return mat
-    mat = created.add(bpy.data.materials.new(SURFACE_MATERIAL))
+    # Warm clay, easy to tell from a grey original.
+    return created.add(new_surface_material(SURFACE_MATERIAL, (0.80, 0.45, 0.25)))
+
+
+def new_surface_material(name, rgb, roughness=0.6):
+    """A plain Principled BSDF material of colour `rgb`."""
+    mat = bpy.data.materials.new(name)
     shader = _output_with(mat, "ShaderNodeBsdfPrincipled", "Surface")
-    colour = (0.80, 0.45, 0.25, 1.0)  # warm clay, easy to tell from a grey original
-    shader.inputs["Base Color"].default_value = colour
-    shader.inputs["Roughness"].default_value = 0.6
-    mat.diffuse_color = colour  # what Solid view shows
+    shader.inputs["Base Color"].default_value = (*rgb, 1.0)
+    shader.inputs["Roughness"].default_value = roughness
+    mat.diffuse_color = (*rgb, 1.0)  # what Solid view shows
     return mat
 
 

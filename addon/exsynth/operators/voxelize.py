@@ -90,7 +90,9 @@ def add_voxel_objects(context, voxels, created):
     volume_io.write_vdb(
         path, {"density": voxels.density, "sdf": voxels.sdf}, voxels.origin, voxels.voxel_size, created
     )
-    vol_obj = volume_io.new_volume_object(f"{voxels.name}_voxels", path, collection, created)
+    vol_obj = volume_io.new_volume_object(
+        f"{voxels.name}_voxels", path, voxels.voxel_size, collection, created
+    )
     vol_obj.data.materials.append(materials.volume_material(created))
     new_objects = [vol_obj]
     if voxels.surface is not None:

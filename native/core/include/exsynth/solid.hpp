@@ -1,0 +1,86 @@
+#pragma once
+// Solid texture synthesis from 2D exemplars (Kopf et al. 2007, "Solid
+// Texture Synthesis from 2D Exemplars") and the same optimiser in 2D.
+//
+// Global texture optimisation: the energy is the sum over voxels v and the
+// three axis-aligned slices through v of ||s_v,i - e_v,i||^r, where s_v,i is
+// the n x n neighbourhood of v in the slice orthogonal to axis i and e_v,i
+// its best match in that axis's exemplar. It alternates a search phase
+// (matches for a sparse grid: every 2nd voxel along both slice axes) and an
+// optimisation phase (each voxel = IRLS-weighted average of the exemplar
+// texels that the overlapping matched neighbourhoods put on it, re-weighted
+// for histogram matching), coarse to fine.
+#include <array>
+#include <cstddef>
+#include <cstdint>
+#include <vector>
+
+#include "exsynth/exec_context.hpp"
+#include "exsynth/grid.hpp"
+#include "exsynth/memory_budget.hpp"
+
+namespace exsynth {
+
+/// How the search phase finds an exemplar neighbourhood for a voxel.
+enum class SolidSearch {
+  KCoherence,  ///< default: candidates from neighbours' matches + their k most similar neighbourhoods
+  KdTree,      ///< paper-faithful: approximate nearest neighbour in PCA space (nanoflann, tolerance eps)
+  Exact,       ///< brute force over every exemplar neighbourhood, full dimension (reference for tests)
+};
+
+struct TextureOptimizationOptions {
+  int levels = 3;                ///< pyramid levels (coarsest first: size / 2^(levels-1))
+  int neighborhood = 8;          ///< n: n x n neighbourhoods (even or odd, >= 3)
+  int iterations = 3;            ///< search + optimise rounds per level (coarsest gets 2x)
+  double r = 0.8;                ///< energy exponent (IRLS weights |s - e|^(r - 2))
+  double pca_variance = 0.95;    ///< PCA keeps this fraction of variance ...
+  int max_pca_dims = 32;         ///< ... but never more than this many dimensions
+  SolidSearch search = SolidSearch::KCoherence;
+  int coherence_k = 4;           ///< k-coherence: similar neighbourhoods per exemplar pixel
+  int random_candidates = 2;     ///< extra random candidates per search (exploration)
+  double ann_eps = 2.0;          ///< KdTree: nanoflann's eps (approximation tolerance)
+  bool histogram_matching = true;
+  int histogram_bins = 16;       ///< per channel
+  bool mean_shift = false;       ///< mean-shift mode of the contributions instead of the mean (sharper)
+  bool tileable = true;          ///< toroidal boundaries, so the output tiles
+  std::size_t memory_budget = kDefaultMemoryBudget;
+  std::uint64_t seed = 0;
+};
+
+/// Inputs of a solid: one exemplar per view (x, y, z = the slice orthogonal
+/// to that axis). Missing views reuse the first exemplar given; a view can be
+/// switched off (two-view mode). All exemplars must have the same channel
+/// count. Slice orientation: x-slices map exemplar (column, row) to (y, z),
+/// y-slices to (x, z), z-slices to (x, y).
+struct SolidExemplars {
+  std::array<Image, 3> views;             ///< empty image = reuse another view's exemplar
+  std::array<bool, 3> active{true, true, true};
+  /// Optional constraint (§6.2): size^3 voxels, channels = C + 1 (C target
+  /// values, then a weight in [0, 1]: 1 = take the target, 0 = ignore it).
+  Volume constraint;
+};
+
+struct SolidOptions : TextureOptimizationOptions {
+  int size = 64;  ///< output edge length in voxels (size^3)
+};
+
+struct TextureResult {
+  Volume texture;                      ///< the solid (size^3 x C), or the image as a (W, H, 1) volume
+  std::vector<double> energy;          ///< mean energy per match after each search, all levels in order
+  std::vector<int> energy_level;       ///< level of each energy entry (0 = coarsest)
+};
+
+TextureResult synthesize_solid(const SolidExemplars& exemplars, const SolidOptions& opt = {},
+                               ExecContext* ctx = nullptr);
+
+struct ImageSynthesisOptions : TextureOptimizationOptions {
+  int width = 128;
+  int height = 128;
+  ImageSynthesisOptions() { tileable = false; }
+};
+
+/// 2D texture optimisation: exemplar -> a width x height image.
+Image synthesize_image(const Image& exemplar, const ImageSynthesisOptions& opt = {}, ExecContext* ctx = nullptr,
+                       std::vector<double>* energy = nullptr);
+
+}  // namespace exsynth

@@ -1,0 +1,75 @@
+#pragma once
+// Everything the search and optimisation phases need to know about one
+// exemplar at one pyramid level: its n x n neighbourhoods (only those fully
+// inside the image: exemplars are not assumed to tile), their PCA
+// coefficients, k-coherence sets, and channel histograms.
+#include <cstdint>
+#include <vector>
+
+#include "exsynth/exec_context.hpp"
+#include "exsynth/grid.hpp"
+#include "search/pca.hpp"
+
+namespace exsynth::solid {
+
+using search::RowMatrixXf;
+
+class ExemplarIndex {
+ public:
+  /// Builds everything; `coherence_k` = 0 skips the k-coherence sets.
+  ExemplarIndex(const Image& image, int n, double pca_variance, int max_pca_dims, int coherence_k, int bins,
+                const std::vector<float>& channel_lo, const std::vector<float>& channel_hi,
+                StageProgress* progress);
+
+  const Image& image() const { return image_; }
+  int n() const { return n_; }
+  /// Window offsets run over [-lo, n - 1 - lo] on both axes.
+  int lo() const { return n_ / 2; }
+  int dims() const { return int(image_.channels()) * n_ * n_; }
+
+  /// Valid neighbourhood centres: index j <-> pixel (lo + j % vw, lo + j / vw).
+  int count() const { return vw_ * vh_; }
+  int centre_u(int j) const { return lo() + j % vw_; }
+  int centre_v(int j) const { return lo() + j / vw_; }
+  /// Index of the valid centre at (u, v), or -1 when its window leaves the image.
+  int index_of(int u, int v) const {
+    const int a = u - lo(), b = v - lo();
+    return (a < 0 || b < 0 || a >= vw_ || b >= vh_) ? -1 : b * vw_ + a;
+  }
+  /// Clamps (u, v) to the valid centres and returns the index.
+  int clamped_index(int u, int v) const;
+
+  const RowMatrixXf& neighbourhoods() const { return neigh_; }  ///< count x dims
+  const search::Pca& pca() const { return pca_; }
+  const RowMatrixXf& coefficients() const { return coeffs_; }    ///< count x pca dims
+  /// k most similar other neighbourhoods of j (indices), k = coherence_k().
+  const std::int32_t* similar(int j) const { return similar_.data() + std::size_t(j) * k_; }
+  int coherence_k() const { return k_; }
+
+  int bins() const { return bins_; }
+  /// Histogram bin of channel c of pixel p (row-major pixel index).
+  std::uint8_t bin(std::size_t p, int c) const { return bin_[p * image_.channels() + c]; }
+  /// Normalised histogram: fraction of pixels in bin b of channel c.
+  double histogram(int c, int b) const { return hist_[std::size_t(c) * bins_ + b]; }
+
+ private:
+  void build_neighbourhoods();
+  void build_coherence(int k, StageProgress* progress);
+
+  Image image_;
+  int n_, vw_, vh_, k_ = 0, bins_;
+  RowMatrixXf neigh_, coeffs_;
+  search::Pca pca_;
+  std::vector<std::int32_t> similar_;
+  std::vector<std::uint8_t> bin_;
+  std::vector<double> hist_;
+};
+
+/// Histogram bin of value x for a channel spanning [lo, hi].
+inline int value_bin(float x, float lo, float hi, int bins) {
+  const float t = hi > lo ? (x - lo) / (hi - lo) : 0.0f;
+  const int b = int(t * bins);
+  return b < 0 ? 0 : (b >= bins ? bins - 1 : b);
+}
+
+}  // namespace exsynth::solid

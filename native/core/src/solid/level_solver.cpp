@@ -1,0 +1,397 @@
+#include "solid/level_solver.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <numeric>
+
+#include <nanoflann.hpp>
+
+#include "exsynth/parallel.hpp"
+#include "exsynth/rng.hpp"
+
+namespace exsynth::solid {
+
+constexpr std::size_t kBatch = 256;  // sparse voxels gathered and PCA-projected together (one GEMM)
+constexpr int kBlock = 8;            // optimisation visits blocks of kBlock^3 voxels in random order
+
+// The paper-faithful search: approximate nearest neighbour in PCA space.
+class KdSearch {
+ public:
+  using Tree = nanoflann::KDTreeEigenMatrixAdaptor<RowMatrixXf, -1, nanoflann::metric_L2_Simple>;
+  explicit KdSearch(const RowMatrixXf& coeffs) : tree_(int(coeffs.cols()), std::cref(coeffs), 16) {
+    tree_.index->buildIndex();
+  }
+  int nearest(const float* q, float eps) const {
+    Eigen::Index idx = 0;
+    float d2 = 0;
+    nanoflann::KNNResultSet<float, Eigen::Index> result(1);
+    result.init(&idx, &d2);
+    tree_.index->findNeighbors(result, q, nanoflann::SearchParams(32, eps));
+    return int(idx);
+  }
+
+ private:
+  Tree tree_;
+};
+
+LevelSolver::LevelSolver(Volume& texture, std::array<const ExemplarIndex*, 3> views, const Volume& constraint,
+                         const TextureOptimizationOptions& opt, bool wrap, std::uint64_t seed,
+                         std::vector<float> channel_lo, std::vector<float> channel_hi)
+    : tex_(texture), constraint_(constraint), opt_(opt), wrap_(wrap), seed_(seed), C_(texture.channels()),
+      n_(opt.neighborhood), lo_(opt.neighborhood / 2), channel_lo_(std::move(channel_lo)),
+      channel_hi_(std::move(channel_hi)) {
+  const int dims[3] = {tex_.nx(), tex_.ny(), tex_.nz()};
+  // wrapped_[a][x + n] for x in [-n, dims[a] + n): wrapped, or clamped when not tileable.
+  for (int a = 0; a < 3; ++a) {
+    wrapped_[a].resize(std::size_t(dims[a]) + 2 * n_);
+    for (int x = -n_; x < dims[a] + n_; ++x)
+      wrapped_[a][x + n_] = wrap_ ? ((x % dims[a]) + dims[a]) % dims[a] : std::clamp(x, 0, dims[a] - 1);
+  }
+  for (int i = 0; i < 3; ++i) {
+    View& w = views_[i];
+    w.ex = views[i];
+    if (!w.ex) continue;
+    const SliceAxes& s = kSlices[i];
+    w.na = dims[s.axis];
+    w.nu = (dims[s.u] + 1) / 2;
+    w.nv = (dims[s.v] + 1) / 2;
+    w.match.assign(w.size(), -1);
+    w.weight.assign(w.size(), 1.0f);
+    if (opt_.search == SolidSearch::KdTree) w.kd = std::make_unique<KdSearch>(w.ex->coefficients());
+  }
+}
+
+LevelSolver::~LevelSolver() = default;
+
+// Progress units: search batches of kBatch sparse voxels; optimisation blocks.
+std::size_t LevelSolver::search_units() const {
+  std::size_t units = 0;
+  for (const View& w : views_) units += w.ex ? (w.size() + kBatch - 1) / kBatch : 0;
+  return units;
+}
+std::size_t LevelSolver::optimize_units() const {
+  return std::size_t((tex_.nx() + kBlock - 1) / kBlock) * ((tex_.ny() + kBlock - 1) / kBlock) *
+         ((tex_.nz() + kBlock - 1) / kBlock);
+}
+
+void LevelSolver::gather(int i, std::size_t sparse, float* row) const {
+  const View& w = views_[i];
+  const SliceAxes& s = kSlices[i];
+  int p[3];
+  p[s.axis] = int(sparse / (std::size_t(w.nu) * w.nv));
+  p[s.v] = 2 * int((sparse / w.nu) % w.nv);
+  p[s.u] = 2 * int(sparse % w.nu);
+  const std::size_t stride[3] = {1, std::size_t(tex_.nx()), std::size_t(tex_.nx()) * tex_.ny()};
+  const int* wu = wrapped_[s.u].data() + n_ + p[s.u] - lo_;
+  const int* wv = wrapped_[s.v].data() + n_ + p[s.v] - lo_;
+  const float* base = tex_.data() + std::size_t(p[s.axis]) * stride[s.axis] * C_;
+  for (int dv = 0; dv < n_; ++dv) {
+    const float* line = base + std::size_t(wv[dv]) * stride[s.v] * C_;
+    for (int du = 0; du < n_; ++du) {
+      const float* src = line + std::size_t(wu[du]) * stride[s.u] * C_;
+      for (int c = 0; c < C_; ++c) *row++ = src[c];  // C is small: a loop beats memmove
+    }
+  }
+}
+
+void LevelSolver::inherit_matches(const LevelSolver& coarser) {
+  for (int i = 0; i < 3; ++i) {
+    View& w = views_[i];
+    const View& c = coarser.views_[i];
+    if (!w.ex || !c.ex) continue;
+    for (std::size_t sp = 0; sp < w.size(); ++sp) {
+      const int a = int(sp / (std::size_t(w.nu) * w.nv)), sv = int((sp / w.nu) % w.nv), su = int(sp % w.nu);
+      // Fine voxel (a, 2su, 2sv) sits on coarse voxel (a/2, su, sv); the
+      // nearest coarse sparse voxel is (su/2, sv/2), offset by (su%2, sv%2).
+      const int ca = std::min(a / 2, c.na - 1), csu = std::min(su / 2, c.nu - 1), csv = std::min(sv / 2, c.nv - 1);
+      const int j = c.match[(std::size_t(ca) * c.nv + csv) * c.nu + csu];
+      if (j < 0) continue;
+      const int u = 2 * (c.ex->centre_u(j) + (su - 2 * csu)), v = 2 * (c.ex->centre_v(j) + (sv - 2 * csv));
+      w.match[sp] = w.ex->clamped_index(u, v);
+    }
+  }
+}
+
+double LevelSolver::search(int iteration, bool exhaustive, StageProgress& progress) {
+  const int D = n_ * n_ * C_;
+  const float r = float(opt_.r);
+  double energy_sum = 0.0;
+  std::size_t energy_count = 0;
+  for (int i = 0; i < 3; ++i) {
+    View& w = views_[i];
+    if (!w.ex) continue;
+    const ExemplarIndex& ex = *w.ex;
+    // Matches are read from the previous round and written to a new one, so
+    // the result does not depend on the order chunks run in.
+    std::vector<std::int32_t> next(w.size());
+    std::vector<float> energy(w.size());
+    const std::size_t batch = kBatch;
+    const std::size_t batches = (w.size() + batch - 1) / batch;
+    parallel_chunks(batches, 1, progress, [&](std::size_t b0, std::size_t b1) {
+      RowMatrixXf x(batch, D);
+      std::vector<int> cand;
+      // stamp[j] = the last query that proposed candidate j: O(1) dedupe.
+      // Coherent neighbours mostly propose the same candidates.
+      std::vector<std::uint32_t> stamp(opt_.search == SolidSearch::KCoherence ? ex.count() : 0, 0);
+      std::uint32_t query = 0;
+      for (std::size_t b = b0; b < b1; ++b) {
+        const std::size_t first = b * batch, rows = std::min(batch, w.size() - first);
+        for (std::size_t k = 0; k < rows; ++k) gather(i, first + k, x.row(Eigen::Index(k)).data());
+        RowMatrixXf y;
+        if (opt_.search != SolidSearch::Exact) y = ex.pca().project(x.topRows(Eigen::Index(rows)));
+        for (std::size_t k = 0; k < rows; ++k) {
+          const std::size_t sp = first + k;
+          int best = -1;
+          if (opt_.search == SolidSearch::Exact) {
+            float bd = std::numeric_limits<float>::max();
+            for (int j = 0; j < ex.count(); ++j) {
+              const float d = (ex.neighbourhoods().row(j) - x.row(Eigen::Index(k))).squaredNorm();
+              if (d < bd) bd = d, best = j;
+            }
+          } else if (opt_.search == SolidSearch::KdTree) {
+            best = w.kd->nearest(y.row(Eigen::Index(k)).data(), float(opt_.ann_eps));
+          } else if (exhaustive) {
+            ((ex.coefficients().rowwise() - y.row(Eigen::Index(k))).rowwise().squaredNorm()).minCoeff(&best);
+          } else {
+            // k-coherence: each sparse neighbour's match, shifted to this
+            // voxel, and that match's k most similar neighbourhoods, shifted
+            // likewise; plus a few random ones to escape local minima.
+            cand.clear();
+            ++query;  // stamps start at 0, queries at 1
+            const int a = int(sp / (std::size_t(w.nu) * w.nv)), sv = int((sp / w.nu) % w.nv), su = int(sp % w.nu);
+            for (int dv = -1; dv <= 1; ++dv)
+              for (int du = -1; du <= 1; ++du) {
+                int nu = su + du, nv = sv + dv;
+                if (wrap_) {
+                  nu = (nu + w.nu) % w.nu;
+                  nv = (nv + w.nv) % w.nv;
+                } else if (nu < 0 || nv < 0 || nu >= w.nu || nv >= w.nv) {
+                  continue;
+                }
+                const int j = w.match[(std::size_t(a) * w.nv + nv) * w.nu + nu];
+                if (j < 0) continue;
+                auto add_shifted = [&](int jj) {
+                  if (jj < 0) return;
+                  const int c = ex.index_of(ex.centre_u(jj) - 2 * du, ex.centre_v(jj) - 2 * dv);
+                  if (c >= 0 && stamp[c] != query) {
+                    stamp[c] = query;
+                    cand.push_back(c);
+                  }
+                };
+                add_shifted(j);
+                const std::int32_t* sim = ex.similar(j);
+                for (int q = 0; q < ex.coherence_k(); ++q) add_shifted(sim[q]);
+              }
+            IndexRng rng(seed_, sp, std::uint64_t(iteration) * 3 + i);
+            for (int q = 0; q < opt_.random_candidates || cand.empty(); ++q) cand.push_back(int(rng.below(ex.count())));
+            // Partial distances: most candidates lose within the first
+            // (highest-variance) PCA dimensions, so stop as soon as they do.
+            float bd = std::numeric_limits<float>::max();
+            const int d = int(y.cols());
+            const float* q = y.row(Eigen::Index(k)).data();
+            for (int c : cand) {
+              const float* e = ex.coefficients().row(c).data();
+              float acc = 0.0f;
+              int t = 0;
+              for (; t < d && acc < bd; t += 4) {
+                const int end = std::min(d, t + 4);
+                for (int u = t; u < end; ++u) acc += (e[u] - q[u]) * (e[u] - q[u]);
+              }
+              if (t >= d && acc < bd) bd = acc, best = c;
+            }
+          }
+          next[sp] = best;
+          const float d2 = (ex.neighbourhoods().row(best) - x.row(Eigen::Index(k))).squaredNorm();
+          energy[sp] = std::pow(d2, 0.5f * r);
+          // IRLS for the |.|^r energy; the floor keeps exact matches finite.
+          w.weight[sp] = std::pow(std::max(d2, 1e-6f), 0.5f * (r - 2.0f));
+        }
+      }
+    });
+    w.match.swap(next);
+    for (float e : energy) energy_sum += e;
+    energy_count += energy.size();
+  }
+  return energy_count ? energy_sum / double(energy_count) : 0.0;
+}
+
+void LevelSolver::optimize(int iteration, StageProgress& progress) {
+  const int dims[3] = {tex_.nx(), tex_.ny(), tex_.nz()};
+  const int bins = opt_.histogram_bins;
+  const bool hist = opt_.histogram_matching;
+
+  // Target histogram: the mean of the active views' exemplar histograms,
+  // scaled so that a uniform histogram is 1 in every bin.
+  std::vector<double> target(std::size_t(C_) * bins, 0.0);
+  int active = 0;
+  for (const View& w : views_)
+    if (w.ex) {
+      ++active;
+      for (int c = 0; c < C_; ++c)
+        for (int b = 0; b < bins; ++b) target[std::size_t(c) * bins + b] += w.ex->histogram(c, b);
+    }
+  for (double& t : target) t *= double(bins) / active;
+
+  std::vector<std::int64_t> counts(std::size_t(C_) * bins, 0);
+  if (hist) {
+    const float* d = tex_.data();
+    for (std::size_t v = 0; v < tex_.voxel_count(); ++v)
+      for (int c = 0; c < C_; ++c) ++counts[std::size_t(c) * bins + value_bin(d[v * C_ + c], channel_lo_[c], channel_hi_[c], bins)];
+  }
+
+  // Blocks of voxels in a seeded random order, processed in groups: within a
+  // group in parallel against the histogram as it was at the group's start,
+  // then the histogram takes the group's changes. Deterministic for any
+  // thread count; "random order with histogram updates" at block granularity.
+  const int B = kBlock;
+  const int bx = (dims[0] + B - 1) / B, by = (dims[1] + B - 1) / B, bz = (dims[2] + B - 1) / B;
+  const std::size_t blocks = std::size_t(bx) * by * bz;
+  std::vector<std::size_t> order(blocks);
+  std::iota(order.begin(), order.end(), std::size_t(0));
+  IndexRng shuffle(seed_, std::uint64_t(iteration), 0xB10C);
+  for (std::size_t k = blocks; k > 1; --k) std::swap(order[k - 1], order[shuffle.below(k)]);
+  const std::size_t groups = std::min<std::size_t>(blocks, 16);
+
+  // Per exemplar pixel: 1 / (1 + sum_c max(0, H_solid - H_exemplar)) at its bins.
+  std::array<std::vector<float>, 3> factor;
+  auto update_factors = [&] {
+    const double total = double(tex_.voxel_count());
+    for (int i = 0; i < 3; ++i) {
+      const View& w = views_[i];
+      if (!w.ex) continue;
+      const Image& img = w.ex->image();
+      factor[i].assign(img.pixel_count(), 1.0f);
+      if (!hist) continue;
+      for (std::size_t p = 0; p < img.pixel_count(); ++p) {
+        double excess = 0.0;
+        for (int c = 0; c < C_; ++c) {
+          const std::size_t k = std::size_t(c) * bins + w.ex->bin(p, c);
+          excess += std::max(0.0, counts[k] * bins / total - target[k]);
+        }
+        factor[i][p] = float(1.0 / (1.0 + excess));
+      }
+    }
+  };
+
+  // wrapped[a][x + n] = x wrapped (or clamped away: -1) along axis a, for
+  // x in [-n, dims[a] + n); window_corner[i][j] = pixel index of window j's
+  // top-left texel in view i's exemplar.
+  std::array<std::vector<int>, 3> wrapped;
+  for (int a = 0; a < 3; ++a) {
+    wrapped[a].resize(std::size_t(dims[a]) + 2 * n_);
+    for (int x = -n_; x < dims[a] + n_; ++x)
+      wrapped[a][x + n_] = wrap_ ? ((x % dims[a]) + dims[a]) % dims[a] : (x < 0 || x >= dims[a] ? -1 : x);
+  }
+  std::array<std::vector<std::int32_t>, 3> window_corner;
+  for (int i = 0; i < 3; ++i) {
+    const View& w = views_[i];
+    if (!w.ex) continue;
+    window_corner[i].resize(w.ex->count());
+    for (int j = 0; j < w.ex->count(); ++j)
+      window_corner[i][j] = (w.ex->centre_v(j) - lo_) * w.ex->image().width() + (w.ex->centre_u(j) - lo_);
+  }
+
+  std::vector<std::vector<std::int64_t>> deltas;
+  for (std::size_t g = 0; g < groups; ++g) {
+    update_factors();
+    const std::size_t g0 = g * blocks / groups, g1 = (g + 1) * blocks / groups;
+    deltas.assign(g1 - g0, {});
+    parallel_chunks(g1 - g0, 1, progress, [&](std::size_t k0, std::size_t k1) {
+      std::vector<float> values, weights;
+      std::vector<float> acc(C_), mode(C_);
+      std::vector<int> du_list(n_), dv_list(n_), su_list(n_), sv_list(n_);
+      for (std::size_t k = k0; k < k1; ++k) {
+        std::vector<std::int64_t>& delta = deltas[k];
+        if (hist) delta.assign(std::size_t(C_) * bins, 0);
+        const std::size_t blk = order[g0 + k];
+        const int x0 = int(blk % bx) * B, y0 = int((blk / bx) % by) * B, z0 = int(blk / (std::size_t(bx) * by)) * B;
+        for (int z = z0; z < std::min(z0 + B, dims[2]); ++z)
+          for (int y = y0; y < std::min(y0 + B, dims[1]); ++y)
+            for (int x = x0; x < std::min(x0 + B, dims[0]); ++x) {
+              const int p[3] = {x, y, z};
+              std::fill(acc.begin(), acc.end(), 0.0f);
+              float wsum = 0.0f;
+              values.clear();
+              weights.clear();
+              for (int i = 0; i < 3; ++i) {
+                const View& w = views_[i];
+                if (!w.ex) continue;
+                const SliceAxes& s = kSlices[i];
+                const Image& img = w.ex->image();
+                // The sparse voxels whose windows cover p: offsets d with
+                // p - (d - lo) on the sparse grid (even), per slice axis.
+                int nu = 0, nv = 0;
+                for (int d = 0; d < n_; ++d) {
+                  const int su = wrapped[s.u][p[s.u] - d + lo_ + n_];
+                  if (su >= 0 && !(su & 1)) du_list[nu] = d, su_list[nu++] = su / 2;
+                  const int sv = wrapped[s.v][p[s.v] - d + lo_ + n_];
+                  if (sv >= 0 && !(sv & 1)) dv_list[nv] = d, sv_list[nv++] = sv / 2;
+                }
+                const std::size_t slice = std::size_t(p[s.axis]) * w.nv;
+                const std::int32_t* corner = window_corner[i].data();
+                const float* fac = factor[i].data();
+                for (int a = 0; a < nv; ++a) {
+                  const std::size_t row = (slice + sv_list[a]) * w.nu;
+                  const std::size_t pix_dv = std::size_t(dv_list[a]) * img.width();
+                  for (int b = 0; b < nu; ++b) {
+                    const std::size_t sp = row + su_list[b];
+                    const int j = w.match[sp];
+                    if (j < 0) continue;
+                    const std::size_t pix = std::size_t(corner[j]) + pix_dv + du_list[b];
+                    const float wt = w.weight[sp] * fac[pix];
+                    const float* e = img.data() + pix * C_;
+                    for (int c = 0; c < C_; ++c) acc[c] += wt * e[c];
+                    wsum += wt;
+                    if (opt_.mean_shift) {
+                      values.insert(values.end(), e, e + C_);
+                      weights.push_back(wt);
+                    }
+                  }
+                }
+              }
+              if (wsum <= 0.0f) continue;
+              for (int c = 0; c < C_; ++c) acc[c] /= wsum;
+              if (opt_.mean_shift && weights.size() > 1) {
+                // Mean shift from the mean with a shrinking Gaussian bandwidth:
+                // converges to the dominant cluster instead of blurring modes.
+                float var = 0.0f;
+                for (std::size_t q = 0; q < weights.size(); ++q)
+                  for (int c = 0; c < C_; ++c) var += weights[q] * (values[q * C_ + c] - acc[c]) * (values[q * C_ + c] - acc[c]);
+                float h2 = std::max(var / wsum, 1e-8f);
+                for (int step = 0; step < 4; ++step, h2 *= 0.25f) {
+                  std::fill(mode.begin(), mode.end(), 0.0f);
+                  float ksum = 0.0f;
+                  for (std::size_t q = 0; q < weights.size(); ++q) {
+                    float d2 = 0.0f;
+                    for (int c = 0; c < C_; ++c) d2 += (values[q * C_ + c] - acc[c]) * (values[q * C_ + c] - acc[c]);
+                    const float kq = weights[q] * std::exp(-0.5f * d2 / h2);
+                    for (int c = 0; c < C_; ++c) mode[c] += kq * values[q * C_ + c];
+                    ksum += kq;
+                  }
+                  if (ksum < 1e-12f) break;
+                  for (int c = 0; c < C_; ++c) acc[c] = mode[c] / ksum;
+                }
+              }
+              if (!constraint_.empty()) {
+                const float wc = std::clamp(constraint_.at(x, y, z, C_), 0.0f, 1.0f);
+                for (int c = 0; c < C_; ++c) acc[c] = (1.0f - wc) * acc[c] + wc * constraint_.at(x, y, z, c);
+              }
+              float* out = tex_.data() + tex_.offset(x, y, z);
+              for (int c = 0; c < C_; ++c) {
+                if (hist) {
+                  --delta[std::size_t(c) * bins + value_bin(out[c], channel_lo_[c], channel_hi_[c], bins)];
+                  ++delta[std::size_t(c) * bins + value_bin(acc[c], channel_lo_[c], channel_hi_[c], bins)];
+                }
+                out[c] = acc[c];
+              }
+            }
+      }
+    });
+    if (hist)
+      for (const auto& delta : deltas)
+        for (std::size_t k = 0; k < delta.size(); ++k) counts[k] += delta[k];
+  }
+}
+
+}  // namespace exsynth::solid

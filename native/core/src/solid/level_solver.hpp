@@ -1,0 +1,70 @@
+#pragma once
+// One pyramid level of the texture optimisation: the matches of the sparse
+// grid for each active view, and the two phases that alternate on them.
+#include <array>
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+#include "exsynth/exec_context.hpp"
+#include "exsynth/grid.hpp"
+#include "exsynth/solid.hpp"
+#include "solid/exemplar_index.hpp"
+
+namespace exsynth::solid {
+
+/// The slice orthogonal to `axis` maps exemplar column -> `u`, row -> `v`.
+struct SliceAxes {
+  int axis, u, v;
+};
+constexpr SliceAxes kSlices[3] = {{0, 1, 2}, {1, 0, 2}, {2, 0, 1}};
+
+class KdSearch;  // PCA-space k-d tree (defined in the .cpp)
+
+class LevelSolver {
+ public:
+  /// `views[i]` = exemplar of the slice orthogonal to axis i, nullptr = view
+  /// inactive. `constraint`: empty or same grid as `texture` with C + 1 channels.
+  /// `channel_lo/hi`: the value range the histogram bins span (as the exemplars').
+  LevelSolver(Volume& texture, std::array<const ExemplarIndex*, 3> views, const Volume& constraint,
+              const TextureOptimizationOptions& opt, bool wrap, std::uint64_t seed,
+              std::vector<float> channel_lo, std::vector<float> channel_hi);
+  ~LevelSolver();
+
+  /// Starts the matches from the next-coarser level's (positions doubled).
+  void inherit_matches(const LevelSolver& coarser);
+
+  /// Search phase; `exhaustive` = search every exemplar neighbourhood (in PCA
+  /// space, or as the options' method says). Returns the mean energy |s-e|^r.
+  double search(int iteration, bool exhaustive, StageProgress& progress);
+  /// Optimisation phase: every voxel from the matched neighbourhoods.
+  void optimize(int iteration, StageProgress& progress);
+
+  /// Units of progress each phase reports (for StageProgress totals).
+  std::size_t search_units() const;
+  std::size_t optimize_units() const;
+
+ private:
+  struct View {
+    const ExemplarIndex* ex = nullptr;
+    int nu = 0, nv = 0, na = 0;          // sparse grid: na slices x nv rows x nu columns
+    std::vector<std::int32_t> match;     // exemplar neighbourhood index per sparse voxel
+    std::vector<float> weight;           // IRLS weight |s - e|^(r - 2)
+    std::unique_ptr<KdSearch> kd;
+    std::size_t size() const { return std::size_t(na) * nv * nu; }
+  };
+
+  void gather(int i, std::size_t sparse, float* row) const;
+
+  Volume& tex_;
+  std::array<View, 3> views_;
+  const Volume& constraint_;
+  const TextureOptimizationOptions& opt_;
+  bool wrap_;
+  std::uint64_t seed_;
+  int C_, n_, lo_;
+  std::vector<float> channel_lo_, channel_hi_;
+  std::array<std::vector<int>, 3> wrapped_;  // per axis: coordinate x + n -> wrapped/clamped x
+};
+
+}  // namespace exsynth::solid

@@ -1,0 +1,269 @@
+// The coarse-to-fine driver shared by solids (three views) and images (one
+// view on a one-voxel-thick volume), and their validation.
+#include <algorithm>
+#include <cmath>
+#include <memory>
+#include <string>
+
+#include "exsynth/errors.hpp"
+#include "exsynth/pyramid.hpp"
+#include "exsynth/rng.hpp"
+#include "exsynth/sample.hpp"
+#include "exsynth/solid.hpp"
+#include "solid/exemplar_index.hpp"
+#include "solid/level_solver.hpp"
+
+namespace exsynth {
+namespace {
+
+const char* kViewName[3] = {"x", "y", "z"};
+
+void check_options(const TextureOptimizationOptions& o) {
+  auto range = [](const char* name, double v, double lo, double hi, const char* hint) {
+    if (!(v >= lo && v <= hi))
+      throw InvalidInput(std::string(name) + " must be between " + std::to_string(lo).substr(0, 6) + " and " +
+                         std::to_string(hi).substr(0, 8) + ", got " + std::to_string(v) + hint);
+  };
+  range("levels", o.levels, 1, 8, "");
+  range("neighborhood", o.neighborhood, 3, 32, " (the paper uses 8)");
+  range("iterations", o.iterations, 1, 100, "");
+  if (!(o.r > 0 && o.r <= 2)) throw InvalidInput("r must be in (0, 2], got " + std::to_string(o.r) + " (the paper uses 0.8)");
+  if (!(o.pca_variance > 0 && o.pca_variance <= 1))
+    throw InvalidInput("pca_variance must be in (0, 1], got " + std::to_string(o.pca_variance));
+  range("max_pca_dims", o.max_pca_dims, 1, 4096, "");
+  range("coherence_k", o.coherence_k, 0, 64, "");
+  range("random_candidates", o.random_candidates, 0, 64, "");
+  range("ann_eps", o.ann_eps, 0, 1e6, "");
+  range("histogram_bins", o.histogram_bins, 2, 256, "");
+}
+
+struct Dims {
+  int d[3];
+  std::size_t voxels() const { return std::size_t(d[0]) * d[1] * d[2]; }
+};
+
+/// Level sizes, coarsest first; each level halves (rounding up) like the pyramids.
+std::vector<Dims> level_dims(Dims finest, int levels) {
+  std::vector<Dims> out(levels);
+  out[levels - 1] = finest;
+  for (int l = levels - 2; l >= 0; --l)
+    for (int a = 0; a < 3; ++a) out[l].d[a] = (out[l + 1].d[a] + 1) / 2;
+  return out;
+}
+
+void check_exemplar(const Image& img, const std::string& what) {
+  if (img.width() < 1 || img.height() < 1 || img.channels() < 1)
+    throw InvalidInput(what + " is empty; give an image with at least one pixel and one channel");
+  for (std::size_t i = 0; i < img.values().size(); ++i)
+    if (!std::isfinite(img.values()[i])) {
+      const std::size_t p = i / img.channels();
+      throw InvalidInput(what + " has a non-finite value (NaN or Inf) at pixel (" + std::to_string(p % img.width()) +
+                         ", " + std::to_string(p / img.width()) + "); fix or clamp the image first");
+    }
+}
+
+struct Job {
+  Dims finest;
+  std::array<const Image*, 3> views{};  // nullptr = inactive view
+  const Volume* constraint = nullptr;
+  std::string name;                      // "solid" or "image", for stages and messages
+};
+
+TextureResult optimize_texture(const Job& job, const TextureOptimizationOptions& opt, bool wrap, ExecContext* ctx) {
+  check_options(opt);
+  const int L = opt.levels, n = opt.neighborhood;
+
+  // Distinct exemplars (views may share one) and their pyramids.
+  std::vector<const Image*> images;
+  std::array<int, 3> image_of{-1, -1, -1};
+  int channels = -1;
+  for (int i = 0; i < 3; ++i) {
+    if (!job.views[i]) continue;
+    auto it = std::find(images.begin(), images.end(), job.views[i]);
+    if (it == images.end()) {
+      const std::string what = job.name == "image" ? "the exemplar" : std::string("the exemplar for view ") + kViewName[i];
+      check_exemplar(*job.views[i], what);
+      if (channels >= 0 && job.views[i]->channels() != channels)
+        throw InvalidInput("the exemplars have different channel counts (" + std::to_string(channels) + " and " +
+                           std::to_string(job.views[i]->channels()) + "); give every view the same channels");
+      channels = job.views[i]->channels();
+      images.push_back(job.views[i]);
+      it = images.end() - 1;
+    }
+    image_of[i] = int(it - images.begin());
+  }
+  if (images.empty()) throw InvalidInput("no exemplar: give at least one exemplar image and one active view");
+
+  const std::vector<Dims> dims = level_dims(job.finest, L);
+  for (int a = 0; a < 3; ++a)
+    if (job.finest.d[a] > 1 && dims[0].d[a] < n)
+      throw InvalidInput("the " + job.name + " is " + std::to_string(job.finest.d[a]) + " voxels across: at the coarsest of " +
+                         std::to_string(L) + " levels that is " + std::to_string(dims[0].d[a]) + ", smaller than the " +
+                         std::to_string(n) + "x" + std::to_string(n) + " neighbourhood; use fewer levels or a larger size");
+
+  PyramidOptions popt;
+  popt.levels = L;
+  std::vector<std::vector<Image>> pyramids;
+  for (std::size_t e = 0; e < images.size(); ++e) {
+    pyramids.push_back(gaussian_pyramid(*images[e], popt));
+    const Image& coarsest = pyramids.back().back();
+    if (coarsest.width() < n || coarsest.height() < n)
+      throw InvalidInput("an exemplar of " + std::to_string(images[e]->width()) + "x" + std::to_string(images[e]->height()) +
+                         " pixels is " + std::to_string(coarsest.width()) + "x" + std::to_string(coarsest.height()) +
+                         " at the coarsest of " + std::to_string(L) + " levels, smaller than the " + std::to_string(n) + "x" +
+                         std::to_string(n) + " neighbourhood; use a larger exemplar, fewer levels or a smaller neighbourhood");
+  }
+
+  if (job.constraint && !job.constraint->empty()) {
+    const Volume& c = *job.constraint;
+    if (c.nx() != job.finest.d[0] || c.ny() != job.finest.d[1] || c.nz() != job.finest.d[2] || c.channels() != channels + 1)
+      throw InvalidInput("the constraint volume must be " + std::to_string(job.finest.d[0]) + "x" + std::to_string(job.finest.d[1]) +
+                         "x" + std::to_string(job.finest.d[2]) + " voxels with " + std::to_string(channels + 1) +
+                         " channels (the exemplar's " + std::to_string(channels) + " target values, then a weight), got " +
+                         std::to_string(c.nx()) + "x" + std::to_string(c.ny()) + "x" + std::to_string(c.nz()) + " with " +
+                         std::to_string(c.channels()));
+    for (float v : c.values())
+      if (!std::isfinite(v)) throw InvalidInput("the constraint volume has a non-finite value; fix it first");
+  }
+
+  // Peak memory: the finest texture twice (upsampling), the sparse matches,
+  // weights and energies (double-buffered), the constraint pyramid and the
+  // exemplar analysis (neighbourhoods, coefficients, a GEMM tile per thread).
+  {
+    const double voxels = double(job.finest.voxels());
+    double bytes = voxels * channels * 4.0 * 2.0 + voxels * 3.0 / 4.0 * 16.0;
+    if (job.constraint && !job.constraint->empty()) bytes += voxels * (channels + 1) * 4.0 * 8.0 / 7.0;
+    for (const Image* img : images) {
+      const double count = double(img->width() - n + 1) * (img->height() - n + 1);
+      bytes += count * (double(n) * n * channels + opt.max_pca_dims + opt.coherence_k) * 4.0 * 1.5 +
+               128.0 * count * 4.0 * 2;
+    }
+    const std::string size = job.name == "image" ? std::to_string(job.finest.d[0]) + "x" + std::to_string(job.finest.d[1])
+                                                 : std::to_string(job.finest.d[0]) + "^3";
+    check_memory_budget(bytes, opt.memory_budget, "synthesizing a " + size + " " + job.name,
+                        "lower the size or raise the memory budget");
+  }
+
+  // Value ranges for the histogram bins: the exemplars' (finest level).
+  std::vector<float> lo(channels, std::numeric_limits<float>::max()), hi(channels, std::numeric_limits<float>::lowest());
+  for (const Image* img : images)
+    for (std::size_t p = 0; p < img->pixel_count(); ++p)
+      for (int c = 0; c < channels; ++c) {
+        lo[c] = std::min(lo[c], img->data()[p * channels + c]);
+        hi[c] = std::max(hi[c], img->data()[p * channels + c]);
+      }
+
+  std::vector<Volume> constraint_levels;
+  if (job.constraint && !job.constraint->empty()) {
+    PyramidOptions cp;
+    cp.levels = L;
+    cp.boundary = wrap ? Boundary::Wrap : Boundary::Clamp;
+    constraint_levels = gaussian_pyramid(*job.constraint, cp);
+  }
+
+  // Progress: each level's share is proportional to its voxel count.
+  double total_work = 0;
+  for (const Dims& d : dims) total_work += double(d.voxels());
+  double done = 0;
+
+  TextureResult result;
+  Volume tex;
+  std::unique_ptr<solid::LevelSolver> previous;
+  std::vector<std::unique_ptr<solid::ExemplarIndex>> prev_index;
+  const Volume empty;
+  for (int l = 0; l < L; ++l) {
+    const double p0 = done / total_work, p1 = (done + double(dims[l].voxels())) / total_work;
+    done += double(dims[l].voxels());
+    const std::string stage = job.name + ": level " + std::to_string(l + 1) + "/" + std::to_string(L);
+    const int pyr = L - 1 - l;  // pyramid index of this level
+
+    std::vector<std::unique_ptr<solid::ExemplarIndex>> index;
+    {
+      StageProgress analysis(ctx, stage + " exemplar analysis", p0, p0 + 0.1 * (p1 - p0), 1);
+      for (std::size_t e = 0; e < images.size(); ++e)
+        index.push_back(std::make_unique<solid::ExemplarIndex>(
+            pyramids[e][pyr], n, opt.pca_variance, opt.max_pca_dims,
+            opt.search == SolidSearch::KCoherence ? opt.coherence_k : 0, opt.histogram_bins, lo, hi, &analysis));
+    }
+    std::array<const solid::ExemplarIndex*, 3> views{};
+    for (int i = 0; i < 3; ++i) views[i] = image_of[i] >= 0 ? index[image_of[i]].get() : nullptr;
+
+    const Dims& d = dims[l];
+    if (l == 0) {
+      // Random exemplar texels (Kopf et al. initialise from the exemplar).
+      int first_view = 0;
+      while (!views[first_view]) ++first_view;  // validated: one view is active
+      const Image& ex = views[first_view]->image();
+      tex = Volume(d.d[0], d.d[1], d.d[2], channels);
+      for (std::size_t v = 0; v < tex.voxel_count(); ++v) {
+        IndexRng rng(opt.seed, v, 0x1417);
+        const std::size_t pix = rng.below(ex.pixel_count());
+        std::copy(ex.data() + pix * channels, ex.data() + (pix + 1) * channels, tex.data() + v * channels);
+      }
+    } else {
+      tex = resize_trilinear(tex, d.d[0], d.d[1], d.d[2], wrap ? Boundary::Wrap : Boundary::Clamp);
+    }
+
+    const Volume& constraint = constraint_levels.empty() ? empty : constraint_levels[pyr];
+    auto solver = std::make_unique<solid::LevelSolver>(tex, views, constraint, opt, wrap,
+                                                       hash_index(opt.seed, std::uint64_t(l), 0x5EED), lo, hi);
+    const bool coarsest = l == 0;
+    if (!coarsest) solver->inherit_matches(*previous);
+    const int iterations = coarsest ? 2 * opt.iterations : opt.iterations;
+    StageProgress progress(ctx, stage, p0 + 0.1 * (p1 - p0), p1,
+                           std::size_t(iterations) * (solver->search_units() + solver->optimize_units()));
+    for (int it = 0; it < iterations; ++it) {
+      // The coarsest level has no coherent matches to start from and is
+      // small: search it exhaustively (in PCA space) until matches settle.
+      result.energy.push_back(solver->search(it, coarsest && it < 2, progress));
+      result.energy_level.push_back(l);
+      solver->optimize(it, progress);
+    }
+    previous = std::move(solver);
+    prev_index = std::move(index);  // the solver's views point into these
+  }
+  if (ctx) ctx->set_progress(1.0);
+  result.texture = std::move(tex);
+  return result;
+}
+
+}  // namespace
+
+TextureResult synthesize_solid(const SolidExemplars& ex, const SolidOptions& opt, ExecContext* ctx) {
+  if (opt.size < 1 || opt.size > 2048)
+    throw InvalidInput("size must be between 1 and 2048 voxels, got " + std::to_string(opt.size));
+  Job job;
+  job.finest = {{opt.size, opt.size, opt.size}};
+  job.name = "solid";
+  const Image* first = nullptr;
+  for (const Image& img : ex.views)
+    if (!img.empty() && !first) first = &img;
+  if (!first) throw InvalidInput("no exemplar: give at least one exemplar image");
+  int active = 0;
+  for (int i = 0; i < 3; ++i) {
+    if (!ex.active[i]) continue;
+    job.views[i] = ex.views[i].empty() ? first : &ex.views[i];
+    ++active;
+  }
+  if (active < 2) throw InvalidInput("a solid needs at least two active views (x, y, z); got " + std::to_string(active));
+  job.constraint = &ex.constraint;
+  return optimize_texture(job, opt, opt.tileable, ctx);
+}
+
+Image synthesize_image(const Image& exemplar, const ImageSynthesisOptions& opt, ExecContext* ctx,
+                       std::vector<double>* energy) {
+  if (opt.width < 1 || opt.height < 1 || opt.width > 16384 || opt.height > 16384)
+    throw InvalidInput("width and height must be between 1 and 16384 pixels, got " + std::to_string(opt.width) + "x" +
+                       std::to_string(opt.height));
+  Job job;
+  job.finest = {{opt.width, opt.height, 1}};
+  job.name = "image";
+  job.views[2] = &exemplar;  // the z-slice of a one-voxel-thick volume is the image
+  TextureResult r = optimize_texture(job, opt, opt.tileable, ctx);
+  if (energy) *energy = r.energy;
+  Image out(opt.width, opt.height, exemplar.channels());
+  std::copy(r.texture.values().begin(), r.texture.values().end(), out.data());
+  return out;
+}
+
+}  // namespace exsynth

@@ -1,0 +1,154 @@
+// exsynth._native.synthesize_solid / synthesize_image
+#include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
+
+#include "arrays.hpp"
+#include "exsynth/errors.hpp"
+#include "exsynth/solid.hpp"
+
+namespace py = pybind11;
+
+namespace exsynth::py_bind {
+namespace {
+
+/// (H, W) or (H, W, C) uint8 / uint16 / float32 / float64 -> Image in [0, 1]
+/// for integer types (8- and 16-bit exemplars), unchanged for floats.
+Image to_image(const py::array& a, const std::string& name) {
+  if (a.ndim() != 2 && a.ndim() != 3)
+    throw InvalidInput("'" + name + "' must be an (H, W) or (H, W, C) image array, got a " + describe(a));
+  const int h = int(a.shape(0)), w = int(a.shape(1)), c = a.ndim() == 3 ? int(a.shape(2)) : 1;
+  if (h < 1 || w < 1 || c < 1) throw InvalidInput("'" + name + "' is empty (" + describe(a) + ")");
+  Image img(w, h, c);
+  float* out = img.data();
+  const std::size_t count = img.values().size();
+  auto copy = [&](auto tag, float scale) {
+    using T = decltype(tag);
+    auto arr = py::array_t<T, py::array::c_style | py::array::forcecast>::ensure(a);
+    const T* src = arr.data();
+    for (std::size_t i = 0; i < count; ++i) out[i] = float(src[i]) * scale;
+  };
+  const auto dt = a.dtype();
+  if (dt.is(py::dtype::of<std::uint8_t>())) copy(std::uint8_t{}, 1.0f / 255.0f);
+  else if (dt.is(py::dtype::of<std::uint16_t>())) copy(std::uint16_t{}, 1.0f / 65535.0f);
+  else if (dt.is(py::dtype::of<float>())) copy(float{}, 1.0f);
+  else if (dt.is(py::dtype::of<double>())) copy(double{}, 1.0f);
+  else
+    throw InvalidInput("'" + name + "' must have dtype uint8, uint16, float32 or float64, got " + describe(a));
+  return img;
+}
+
+SolidSearch to_search(const std::string& s) {
+  if (s == "kcoherence") return SolidSearch::KCoherence;
+  if (s == "kdtree") return SolidSearch::KdTree;
+  if (s == "exact") return SolidSearch::Exact;
+  throw InvalidInput("search must be 'kcoherence', 'kdtree' or 'exact', got '" + s + "'");
+}
+
+// The options both entry points share, in one place.
+void set_common(TextureOptimizationOptions& o, const py::kwargs& kw) {
+  for (auto item : kw) {
+    const std::string k = py::str(item.first);
+    const py::handle v = item.second;
+    if (k == "levels") o.levels = v.cast<int>();
+    else if (k == "neighborhood") o.neighborhood = v.cast<int>();
+    else if (k == "iterations") o.iterations = v.cast<int>();
+    else if (k == "r") o.r = v.cast<double>();
+    else if (k == "pca_variance") o.pca_variance = v.cast<double>();
+    else if (k == "max_pca_dims") o.max_pca_dims = v.cast<int>();
+    else if (k == "search") o.search = to_search(v.cast<std::string>());
+    else if (k == "coherence_k") o.coherence_k = v.cast<int>();
+    else if (k == "random_candidates") o.random_candidates = v.cast<int>();
+    else if (k == "ann_eps") o.ann_eps = v.cast<double>();
+    else if (k == "histogram_matching") o.histogram_matching = v.cast<bool>();
+    else if (k == "histogram_bins") o.histogram_bins = v.cast<int>();
+    else if (k == "mean_shift") o.mean_shift = v.cast<bool>();
+    else if (k == "tileable") o.tileable = v.cast<bool>();
+    else if (k == "memory_budget") o.memory_budget = v.cast<std::size_t>() ? v.cast<std::size_t>() : kDefaultMemoryBudget;
+    else if (k == "seed") o.seed = v.cast<std::uint64_t>();
+    else
+      throw InvalidInput("unknown option '" + k +
+                         "'; options: levels, neighborhood, iterations, r, pca_variance, max_pca_dims, search, "
+                         "coherence_k, random_candidates, ann_eps, histogram_matching, histogram_bins, mean_shift, "
+                         "tileable, memory_budget, seed");
+  }
+}
+
+py::list to_list(const std::vector<double>& v) {
+  py::list l;
+  for (double x : v) l.append(x);
+  return l;
+}
+
+}  // namespace
+
+void bind_solid(py::module_& m) {
+  m.def(
+      "synthesize_solid",
+      [](const py::array& exemplar, const py::object& exemplar_y, const py::object& exemplar_z, const std::string& views,
+         int size, const py::object& constraint, ExecContext* ctx, const py::kwargs& kw) {
+        SolidExemplars ex;
+        ex.views[0] = to_image(exemplar, "exemplar");
+        if (!exemplar_y.is_none()) ex.views[1] = to_image(exemplar_y.cast<py::array>(), "exemplar_y");
+        if (!exemplar_z.is_none()) ex.views[2] = to_image(exemplar_z.cast<py::array>(), "exemplar_z");
+        for (int i = 0; i < 3; ++i) ex.active[i] = views.find("xyz"[i]) != std::string::npos;
+        for (char c : views)
+          if (c != 'x' && c != 'y' && c != 'z')
+            throw InvalidInput("views must name the active slices with x, y and z (e.g. 'xyz' or 'xy'), got '" + views + "'");
+        if (!constraint.is_none()) ex.constraint = to_volume(constraint.cast<py::array>(), "constraint", GridTransform{});
+        SolidOptions opt;
+        opt.size = size;
+        set_common(opt, kw);
+        TextureResult r;
+        {
+          py::gil_scoped_release release;
+          r = synthesize_solid(ex, opt, ctx);
+        }
+        py::dict out;
+        out["energy"] = to_list(r.energy);
+        out["energy_level"] = py::cast(r.energy_level);
+        Volume& t = r.texture;
+        const py::ssize_t c = t.channels();
+        out["solid"] = take_vector(std::move(t.values()), {t.nz(), t.ny(), t.nx(), c});
+        return out;
+      },
+      py::arg("exemplar"), py::kw_only(), py::arg("exemplar_y") = py::none(), py::arg("exemplar_z") = py::none(),
+      py::arg("views") = "xyz", py::arg("size") = 64, py::arg("constraint") = py::none(),
+      py::arg("ctx") = static_cast<ExecContext*>(nullptr),
+      R"doc(Solid texture from 2D exemplars (Kopf et al. 2007).
+
+exemplar: (H, W) or (H, W, C) uint8/uint16 (scaled to [0, 1]) or float; used for every view
+without its own. exemplar_y / exemplar_z: the y- and z-slice exemplars (same channels).
+views: active slices, 'xyz' or two of them. constraint: (size, size, size, C + 1) float32:
+target values then a weight in [0, 1]. Options (keywords): levels=3, neighborhood=8,
+iterations=3, r=0.8, pca_variance=0.95, max_pca_dims=32, search='kcoherence'|'kdtree'|'exact',
+coherence_k=4, random_candidates=2, ann_eps=2.0, histogram_matching=True, histogram_bins=16,
+mean_shift=False, tileable=True, memory_budget=0 (default), seed=0.
+Returns {'solid': (Z, Y, X, C) float32, 'energy': [...], 'energy_level': [...]}.)doc");
+
+  m.def(
+      "synthesize_image",
+      [](const py::array& exemplar, int width, int height, ExecContext* ctx, const py::kwargs& kw) {
+        const Image ex = to_image(exemplar, "exemplar");
+        ImageSynthesisOptions opt;
+        opt.width = width;
+        opt.height = height;
+        set_common(opt, kw);
+        Image img;
+        std::vector<double> energy;
+        {
+          py::gil_scoped_release release;
+          img = synthesize_image(ex, opt, ctx, &energy);
+        }
+        py::dict out;
+        out["energy"] = to_list(energy);
+        const py::ssize_t h = img.height(), w = img.width(), c = img.channels();
+        out["image"] = take_vector(std::move(img.values()), {h, w, c});
+        return out;
+      },
+      py::arg("exemplar"), py::kw_only(), py::arg("width") = 128, py::arg("height") = 128,
+      py::arg("ctx") = static_cast<ExecContext*>(nullptr),
+      "2D texture optimisation: exemplar -> (height, width, C) float32 image (tileable=True to tile).\n"
+      "Same options as synthesize_solid. Returns {'image': ..., 'energy': [...]}.");
+}
+
+}  // namespace exsynth::py_bind

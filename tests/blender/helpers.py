@@ -1,0 +1,72 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
+"""Helpers shared by the add-on tests (plain functions; fixtures are in conftest.py)."""
+
+import os
+
+import bpy
+import numpy as np
+
+from exsynth.io import volume as volume_io
+
+ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+BUNNY_OBJ = os.path.join(ROOT, "assets", "meshes", "bunny.obj")
+
+
+def scene_state():
+    """Everything a failed or cancelled run must leave untouched."""
+    cache = volume_io.cache_dir()
+    return {
+        "objects": sorted(o.name for o in bpy.data.objects),
+        "meshes": sorted(m.name for m in bpy.data.meshes),
+        "volumes": sorted(v.name for v in bpy.data.volumes),
+        "materials": sorted(m.name for m in bpy.data.materials),
+        "images": sorted(i.name for i in bpy.data.images),
+        "collection": sorted(o.name for o in bpy.context.collection.objects),
+        "selected": sorted(o.name for o in bpy.context.view_layer.objects.selected),
+        "active": getattr(bpy.context.view_layer.objects.active, "name", None),
+        "cache_files": sorted(os.listdir(cache)) if os.path.isdir(cache) else None,
+    }
+
+
+def world_mesh(obj):
+    """(vertices V by 3 in world space, triangles F by 3) of an object's mesh."""
+    obj.data.calc_loop_triangles()
+    co = np.empty(3 * len(obj.data.vertices), np.float32)
+    obj.data.vertices.foreach_get("co", co)
+    tris = np.empty(3 * len(obj.data.loop_triangles), np.int32)
+    obj.data.loop_triangles.foreach_get("vertices", tris)
+    m = np.array(obj.matrix_world)
+    return co.reshape(-1, 3) @ m[:3, :3].T + m[:3, 3], tris.reshape(-1, 3)
+
+
+def enclosed_volume(vertices, triangles):
+    """Divergence theorem; positive when the normals point outwards."""
+    v = np.asarray(vertices, np.float64)[triangles]
+    return float(np.einsum("ij,ij->i", v[:, 0], np.cross(v[:, 1], v[:, 2])).sum() / 6.0)
+
+
+def volume_surface_points(volume_obj, grid_name, threshold):
+    """World-space vertices of Blender's own Volume to Mesh of one grid: how
+    Blender itself places the voxels (render and modifiers agree on this)."""
+    probe = bpy.data.objects.new("probe", bpy.data.meshes.new("probe"))
+    bpy.context.collection.objects.link(probe)
+    try:
+        mod = probe.modifiers.new("to_mesh", 'VOLUME_TO_MESH')
+        mod.object = volume_obj
+        mod.grid_name = grid_name
+        mod.threshold = threshold
+        depsgraph = bpy.context.evaluated_depsgraph_get()
+        probe_eval = probe.evaluated_get(depsgraph)
+        mesh = probe_eval.to_mesh()
+        co = np.empty(3 * len(mesh.vertices), np.float32)
+        mesh.vertices.foreach_get("co", co)
+        m = np.array(probe_eval.matrix_world)
+        probe_eval.to_mesh_clear()
+    finally:
+        bpy.data.batch_remove([probe, probe.data])
+    return co.reshape(-1, 3) @ m[:3, :3].T + m[:3, 3]
+
+
+def bbox(points):
+    points = np.asarray(points)
+    return points.min(axis=0), points.max(axis=0)
