@@ -1,0 +1,30 @@
+#pragma once
+// Structured synthetic exemplars for C++ tests (PNG exemplars are used in
+// the Python tier): random soft discs on a background, in C channels.
+#include <algorithm>
+#include <cmath>
+
+#include "exsynth/grid.hpp"
+#include "exsynth/rng.hpp"
+
+namespace exsynth::testing {
+
+inline Image disc_texture(int w, int h, int channels, std::uint64_t seed, int discs = 14, float radius = 3.5f) {
+  Image img(w, h, channels, 0.15f);
+  for (int k = 0; k < discs; ++k) {
+    IndexRng r(seed, std::uint64_t(k));
+    const float cx = float(r.uniform() * w), cy = float(r.uniform() * h);
+    const float rad = radius * float(0.7 + 0.6 * r.uniform());
+    float colour[16];
+    for (int c = 0; c < channels; ++c) colour[c] = float(0.5 + 0.5 * r.uniform());
+    for (int y = 0; y < h; ++y)
+      for (int x = 0; x < w; ++x) {
+        const float d = std::hypot(x - cx, y - cy);
+        const float a = std::clamp(rad + 0.5f - d, 0.0f, 1.0f);
+        for (int c = 0; c < channels; ++c) img.at(x, y, c) = (1 - a) * img.at(x, y, c) + a * colour[c];
+      }
+  }
+  return img;
+}
+
+}  // namespace exsynth::testing

@@ -1,0 +1,296 @@
+// Solid and 2D texture optimisation (Kopf et al. 2007): energy, histogram,
+// resemblance of every slice axis to the exemplar, tiling, fast search vs the
+// exact reference, determinism, constraints and bad input.
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+#include <tbb/global_control.h>
+
+#include <cmath>
+#include <limits>
+
+#include "exsynth/solid.hpp"
+#include "support/textures.hpp"
+
+using namespace exsynth;
+using exsynth::testing::disc_texture;
+using ::testing::HasSubstr;
+
+namespace {
+
+SolidOptions small_options() {
+  SolidOptions o;
+  o.size = 24;
+  o.levels = 2;
+  o.iterations = 3;
+  o.seed = 5;
+  return o;
+}
+
+SolidExemplars one_exemplar(const Image& img) {
+  SolidExemplars ex;
+  ex.views[0] = img;
+  return ex;
+}
+
+// Mean over n sampled 8x8 windows of a slice of their distance to the
+// nearest exemplar window (brute force): how much a slice looks like the exemplar.
+double slice_to_exemplar_distance(const Volume& v, int axis, const Image& ex, int samples = 40) {
+  const int n = 8, C = v.channels();
+  const int u = axis == 0 ? 1 : 0, w = axis == 2 ? 1 : 2;
+  const int dims[3] = {v.nx(), v.ny(), v.nz()};
+  double total = 0;
+  for (int s = 0; s < samples; ++s) {
+    IndexRng r(99, std::uint64_t(s), std::uint64_t(axis));
+    int p[3] = {int(r.below(dims[0])), int(r.below(dims[1])), int(r.below(dims[2]))};
+    std::vector<float> win;
+    for (int dv = 0; dv < n; ++dv)
+      for (int du = 0; du < n; ++du) {
+        int q[3] = {p[0], p[1], p[2]};
+        q[u] = (p[u] + du) % dims[u];
+        q[w] = (p[w] + dv) % dims[w];
+        for (int c = 0; c < C; ++c) win.push_back(v.at(q[0], q[1], q[2], c));
+      }
+    double best = std::numeric_limits<double>::max();
+    for (int ey = 0; ey + n <= ex.height(); ++ey)
+      for (int exx = 0; exx + n <= ex.width(); ++exx) {
+        double d = 0;
+        std::size_t k = 0;
+        for (int dv = 0; dv < n; ++dv)
+          for (int du = 0; du < n; ++du)
+            for (int c = 0; c < C; ++c, ++k) d += std::pow(win[k] - ex.at(exx + du, ey + dv, c), 2);
+        best = std::min(best, d);
+      }
+    total += std::sqrt(best);
+  }
+  return total / samples;
+}
+
+// The same volume with its voxels shuffled: the exemplar's colours without its structure.
+Volume shuffled(const Volume& v) {
+  Volume s = v;
+  const std::size_t N = v.voxel_count();
+  for (std::size_t k = N; k > 1; --k) {
+    const std::size_t j = IndexRng(3, k).below(k);
+    for (int c = 0; c < v.channels(); ++c) std::swap(s.data()[(k - 1) * v.channels() + c], s.data()[j * v.channels() + c]);
+  }
+  return s;
+}
+
+std::vector<double> histogram(const float* data, std::size_t count, int C, int c, int bins) {
+  std::vector<double> h(bins, 0.0);
+  for (std::size_t i = 0; i < count; ++i) h[std::clamp(int(data[i * C + c] * bins), 0, bins - 1)] += 1.0 / count;
+  return h;
+}
+
+double l1(const std::vector<double>& a, const std::vector<double>& b) {
+  double s = 0;
+  for (std::size_t i = 0; i < a.size(); ++i) s += std::abs(a[i] - b[i]);
+  return s;
+}
+
+}  // namespace
+
+TEST(Solid, EnergyDecreasesWithinEachLevel) {
+  const Image ex = disc_texture(32, 32, 3, 1);
+  const TextureResult r = synthesize_solid(one_exemplar(ex), small_options());
+  ASSERT_EQ(r.energy.size(), r.energy_level.size());
+  // First round of each level vs its last: the optimisation must lower it.
+  for (int level = 0; level < 2; ++level) {
+    double first = -1, last = -1;
+    for (std::size_t k = 0; k < r.energy.size(); ++k)
+      if (r.energy_level[k] == level) {
+        if (first < 0) first = r.energy[k];
+        last = r.energy[k];
+      }
+    EXPECT_LT(last, first) << "level " << level;
+  }
+}
+
+TEST(Solid, EverySliceAxisResemblesTheExemplar) {
+  const Image ex = disc_texture(32, 32, 3, 2);
+  const TextureResult r = synthesize_solid(one_exemplar(ex), small_options());
+  const Volume baseline = shuffled(r.texture);
+  for (int axis = 0; axis < 3; ++axis) {
+    const double solid = slice_to_exemplar_distance(r.texture, axis, ex);
+    const double shuffled_pixels = slice_to_exemplar_distance(baseline, axis, ex);
+    EXPECT_LT(solid, 0.5 * shuffled_pixels) << "axis " << axis;
+  }
+}
+
+TEST(Solid, HistogramMatchingKeepsTheExemplarsHistogram) {
+  const Image ex = disc_texture(32, 32, 1, 4);
+  SolidOptions on = small_options(), off = small_options();
+  off.histogram_matching = false;
+  const TextureResult a = synthesize_solid(one_exemplar(ex), on);
+  const TextureResult b = synthesize_solid(one_exemplar(ex), off);
+  const auto target = histogram(ex.data(), ex.pixel_count(), 1, 0, 16);
+  const double with = l1(histogram(a.texture.data(), a.texture.voxel_count(), 1, 0, 16), target);
+  const double without = l1(histogram(b.texture.data(), b.texture.voxel_count(), 1, 0, 16), target);
+  EXPECT_LT(with, 0.6);  // total variation distance x 2, in [0, 2]
+  EXPECT_LT(with, without);
+}
+
+TEST(Solid, ToroidalSolidTilesAcrossItsFaces) {
+  const Image ex = disc_texture(32, 32, 3, 6);
+  const TextureResult r = synthesize_solid(one_exemplar(ex), small_options());
+  const Volume& v = r.texture;
+  const int N = v.nx();
+  // The step across the wrap-around seam (N-1 -> 0) is no larger than a
+  // typical step between neighbouring interior slices, on every axis. Steps
+  // from an odd to an even slice are compared with their own kind: with
+  // 8x8 windows on a stride-2 sparse grid, even -> odd neighbours share all
+  // their windows but odd -> even ones only three of four, and are rougher.
+  for (int axis = 0; axis < 3; ++axis) {
+    auto step = [&](int a, int b) {
+      double s = 0;
+      for (int i = 0; i < N; ++i)
+        for (int j = 0; j < N; ++j) {
+          int p[3], q[3];
+          p[axis] = a, q[axis] = b;
+          p[(axis + 1) % 3] = q[(axis + 1) % 3] = i;
+          p[(axis + 2) % 3] = q[(axis + 2) % 3] = j;
+          for (int c = 0; c < 3; ++c) s += std::abs(v.at(p[0], p[1], p[2], c) - v.at(q[0], q[1], q[2], c));
+        }
+      return s;
+    };
+    double interior = 0;
+    for (int a = 1; a + 1 < N; a += 2) interior += step(a, a + 1) / (N / 2 - 1);
+    EXPECT_LT(step(N - 1, 0), 1.5 * interior) << "axis " << axis;
+  }
+}
+
+TEST(Solid, CoherentSearchComesCloseToExactSearch) {
+  const Image ex = disc_texture(20, 20, 3, 8, 6);
+  SolidOptions fast = small_options();
+  fast.size = 16;
+  fast.levels = 1;
+  fast.iterations = 4;
+  SolidOptions exact = fast;
+  exact.search = SolidSearch::Exact;
+  const double e_fast = synthesize_solid(one_exemplar(ex), fast).energy.back();
+  const double e_exact = synthesize_solid(one_exemplar(ex), exact).energy.back();
+  EXPECT_LT(e_fast, 1.25 * e_exact);
+  SolidOptions kd = fast;
+  kd.search = SolidSearch::KdTree;
+  kd.ann_eps = 0.0;  // exact in PCA space
+  EXPECT_LT(synthesize_solid(one_exemplar(ex), kd).energy.back(), 1.25 * e_exact);
+}
+
+TEST(Solid, SameSeedSameSolidWithOneOrTwoThreads) {
+  const Image ex = disc_texture(32, 32, 3, 10);
+  TextureResult one, two;
+  {
+    tbb::global_control limit(tbb::global_control::max_allowed_parallelism, 1);
+    one = synthesize_solid(one_exemplar(ex), small_options());
+  }
+  {
+    tbb::global_control limit(tbb::global_control::max_allowed_parallelism, 2);
+    two = synthesize_solid(one_exemplar(ex), small_options());
+  }
+  EXPECT_EQ(one.texture.values(), two.texture.values());
+  SolidOptions other = small_options();
+  other.seed = 6;
+  EXPECT_NE(synthesize_solid(one_exemplar(ex), other).texture.values(), one.texture.values());
+}
+
+TEST(Solid, PerViewExemplarsTwoViewsAndManyChannels) {
+  SolidExemplars ex;
+  ex.views[0] = disc_texture(32, 32, 6, 11);
+  ex.views[2] = disc_texture(32, 32, 6, 12);
+  ex.active = {true, false, true};
+  const TextureResult r = synthesize_solid(ex, small_options());
+  EXPECT_EQ(r.texture.channels(), 6);
+  EXPECT_EQ(r.texture.nx(), 24);
+  const Volume baseline = shuffled(r.texture);
+  EXPECT_LT(slice_to_exemplar_distance(r.texture, 0, ex.views[0]), 0.5 * slice_to_exemplar_distance(baseline, 0, ex.views[0]));
+  EXPECT_LT(slice_to_exemplar_distance(r.texture, 2, ex.views[2]), 0.5 * slice_to_exemplar_distance(baseline, 2, ex.views[2]));
+}
+
+TEST(Solid, FullWeightConstraintIsReproduced) {
+  const Image ex = disc_texture(32, 32, 1, 13);
+  SolidExemplars in = one_exemplar(ex);
+  SolidOptions o = small_options();
+  in.constraint = Volume(o.size, o.size, o.size, 2, 0.0f);
+  for (int z = 0; z < o.size; ++z)
+    for (int y = 0; y < o.size; ++y)
+      for (int x = 0; x < o.size; ++x) {
+        in.constraint.at(x, y, z, 0) = x < o.size / 2 ? 0.2f : 0.8f;
+        in.constraint.at(x, y, z, 1) = 1.0f;  // weight
+      }
+  const TextureResult r = synthesize_solid(in, o);
+  for (std::size_t v = 0; v < r.texture.voxel_count(); ++v)
+    ASSERT_NEAR(r.texture.values()[v], in.constraint.values()[v * 2], 1e-5f);
+}
+
+TEST(Solid, CancelStopsTheJob) {
+  ExecContext ctx;
+  ctx.cancel();
+  EXPECT_THROW(synthesize_solid(one_exemplar(disc_texture(32, 32, 3, 1)), small_options(), &ctx), Cancelled);
+}
+
+TEST(SolidErrors, BadInputsNameTheProblem) {
+  auto message = [](const SolidExemplars& ex, const SolidOptions& o) -> std::string {
+    try {
+      synthesize_solid(ex, o);
+    } catch (const InvalidInput& e) {
+      return e.what();
+    }
+    return "no error";
+  };
+  const SolidOptions o = small_options();
+  EXPECT_THAT(message(one_exemplar(disc_texture(12, 12, 3, 1)), o), HasSubstr("smaller than the 8x8 neighbourhood"));
+  EXPECT_THAT(message(one_exemplar(Image(1, 1, 3, 0.5f)), o), HasSubstr("smaller than the 8x8 neighbourhood"));
+  EXPECT_THAT(message(SolidExemplars{}, o), HasSubstr("no exemplar"));
+  Image nan = disc_texture(32, 32, 3, 1);
+  nan.at(3, 4, 1) = std::numeric_limits<float>::quiet_NaN();
+  EXPECT_THAT(message(one_exemplar(nan), o), HasSubstr("pixel (3, 4)"));
+  Image inf = disc_texture(32, 32, 3, 1);
+  inf.at(0, 0, 0) = std::numeric_limits<float>::infinity();
+  EXPECT_THAT(message(one_exemplar(inf), o), HasSubstr("non-finite"));
+  SolidExemplars mixed;
+  mixed.views[0] = disc_texture(32, 32, 3, 1);
+  mixed.views[1] = disc_texture(32, 32, 4, 1);
+  EXPECT_THAT(message(mixed, o), HasSubstr("different channel counts"));
+  SolidExemplars constrained = one_exemplar(disc_texture(32, 32, 3, 1));
+  constrained.constraint = Volume(8, 8, 8, 4);
+  EXPECT_THAT(message(constrained, o), HasSubstr("constraint volume must be 24x24x24 voxels with 4 channels"));
+  constrained.constraint = Volume(24, 24, 24, 3);
+  EXPECT_THAT(message(constrained, o), HasSubstr("with 4 channels"));
+  SolidOptions tiny = o;
+  tiny.size = 8;
+  EXPECT_THAT(message(one_exemplar(disc_texture(32, 32, 3, 1)), tiny), HasSubstr("fewer levels or a larger size"));
+  SolidExemplars one_view = one_exemplar(disc_texture(32, 32, 3, 1));
+  one_view.active = {false, false, true};
+  EXPECT_THAT(message(one_view, o), HasSubstr("two active views"));
+  SolidOptions bad = o;
+  bad.neighborhood = 2;
+  EXPECT_THAT(message(one_exemplar(disc_texture(32, 32, 3, 1)), bad), HasSubstr("neighborhood"));
+}
+
+TEST(SolidErrors, RefusesSizesOverTheMemoryBudget) {
+  SolidOptions o = small_options();
+  o.size = 2048;
+  try {
+    synthesize_solid(one_exemplar(disc_texture(32, 32, 3, 1)), o);
+    FAIL();
+  } catch (const OverBudget& e) {
+    EXPECT_THAT(e.what(), HasSubstr("lower the size"));
+  }
+}
+
+TEST(Image2D, SynthesisesTheRequestedSizeAndTiles) {
+  const Image ex = disc_texture(32, 32, 3, 14);
+  ImageSynthesisOptions o;
+  o.width = 48;
+  o.height = 40;
+  o.levels = 2;
+  o.tileable = true;
+  std::vector<double> energy;
+  const Image out = synthesize_image(ex, o, nullptr, &energy);
+  EXPECT_EQ(out.width(), 48);
+  EXPECT_EQ(out.height(), 40);
+  EXPECT_LT(energy.back(), energy.front());
+  Volume as_volume(48, 40, 1, 3);
+  as_volume.values() = out.values();
+  EXPECT_LT(slice_to_exemplar_distance(as_volume, 2, ex), 0.5 * slice_to_exemplar_distance(shuffled(as_volume), 2, ex));
+}
