@@ -108,6 +108,7 @@ class Created:
     def __init__(self):
         self.ids = []
         self.files = []
+        self.undos = []
 
     def add(self, id_block):
         self.ids.append(id_block)
@@ -118,9 +119,20 @@ class Created:
         self.files.append(path)
         return path
 
+    def add_undo(self, undo):
+        """A change to existing data (a new UV map, a replaced material):
+        `undo()` puts it back. Undos run first, newest first, then the new
+        datablocks and files go."""
+        self.undos.append(undo)
+
     def rollback(self):
         # Best effort throughout: the error that caused the rollback is the
         # one the user needs to see, not a second one from cleaning up.
+        for undo in reversed(self.undos):
+            try:
+                undo()
+            except (ReferenceError, RuntimeError, KeyError, ValueError, AttributeError):
+                pass
         alive = []
         for id_block in reversed(self.ids):
             try:
@@ -140,6 +152,7 @@ class Created:
                 pass
         self.ids.clear()
         self.files.clear()
+        self.undos.clear()
 
 
 class JobOperator:

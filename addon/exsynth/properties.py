@@ -2,7 +2,7 @@
 """The add-on's settings: one PropertyGroup, stored on the Scene as `scene.exsynth`."""
 
 import bpy
-from bpy.props import BoolProperty, FloatProperty, IntProperty, PointerProperty
+from bpy.props import BoolProperty, EnumProperty, FloatProperty, IntProperty, PointerProperty
 
 GIB = 1 << 30
 
@@ -40,6 +40,77 @@ class ExSynthSettings(bpy.types.PropertyGroup):
         description="Refuse a job whose estimated peak memory exceeds this many GiB "
         "(checked before anything is allocated)",
         default=8.0, min=0.001, max=1024.0, soft_max=64.0, precision=3, unit='NONE',
+    )
+
+    # ---- Solid Texture ------------------------------------------------------
+    solid_exemplar: PointerProperty(
+        name="Exemplar",
+        description="The 2D texture the solid should look like on every slice "
+        "(any image: packed or on disk, 8/16-bit or float)",
+        type=bpy.types.Image,
+    )
+    solid_exemplar_y: PointerProperty(
+        name="Exemplar Y",
+        description="Optional: what slices across the Y axis (the XZ plane) should look like; "
+        "empty uses the main exemplar",
+        type=bpy.types.Image,
+    )
+    solid_exemplar_z: PointerProperty(
+        name="Exemplar Z",
+        description="Optional: what slices across the Z axis (the XY plane) should look like; "
+        "empty uses the main exemplar",
+        type=bpy.types.Image,
+    )
+    solid_use_alpha: BoolProperty(
+        name="Alpha",
+        description="Synthesize the exemplar's alpha as a fourth channel (kept in the images and "
+        "as the Volume's 'alpha' grid)",
+        default=False,
+    )
+    solid_size: IntProperty(
+        name="Size",
+        description="Voxels along each edge of the solid (it is Size × Size × Size and tiles)",
+        default=64, min=16, max=256,
+    )
+    solid_levels: IntProperty(
+        name="Levels",
+        description="Coarse-to-fine levels; the coarsest (Size / 2^(Levels-1)) and the exemplar at "
+        "that level must be at least 8 pixels across",
+        default=3, min=1, max=6,
+    )
+    solid_iterations: IntProperty(
+        name="Iterations",
+        description="Optimisation rounds per level (more: closer to the exemplar, slower)",
+        default=3, min=1, max=20,
+    )
+    solid_scale: FloatProperty(
+        name="Scale",
+        description="Edge length of one tile of the solid, in the units of the solid's Volume object "
+        "(world units when it is created); the texture repeats beyond it",
+        default=1.0, min=1e-4, soft_max=100.0, subtype='DISTANCE', unit='LENGTH',
+    )
+    solid_bake_target: EnumProperty(
+        name="Bake To",
+        description="Where the solid's colours go on each selected mesh",
+        items=(
+            ('IMAGE', "Image Texture", "A new image over the mesh's UV map (made with Smart UV Project "
+             "when it has none), shown by a new material"),
+            ('ATTRIBUTE', "Color Attribute", "A face-corner colour attribute 'solid' (no UVs needed; "
+             "detail limited by the mesh's density)"),
+        ),
+        default='IMAGE',
+    )
+    solid_bake_resolution: IntProperty(
+        name="Resolution",
+        description="Width and height of each baked image, in pixels",
+        default=1024, min=16, max=16384, soft_max=8192,
+    )
+    solid_volume: PointerProperty(
+        name="Solid",
+        description="The solid to bake from: a Volume object made by Solid Texture (its .vdb and "
+        "its place in the scene define the texture)",
+        type=bpy.types.Object,
+        poll=lambda self, obj: obj.type == 'VOLUME',
     )
 
     @property

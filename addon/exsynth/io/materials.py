@@ -52,3 +52,62 @@ def _output_with(mat, shader_type, output_socket):
     shader = nodes.new(shader_type)
     mat.node_tree.links.new(shader.outputs[0], out.inputs[output_socket])
     return shader
+
+
+def solid_volume_material(name, srgb, density, created):
+    """A new material showing a solid's `color` grid in a Volume object.
+
+    `srgb`: the grid holds display-encoded colours (from an 8-bit exemplar),
+    turned back to linear for rendering with a gamma of 2.2. `density` is per
+    unit length, so that a tile of the solid renders as a dense block."""
+    mat = created.add(bpy.data.materials.new(name))
+    shader = _output_with(mat, "ShaderNodeVolumePrincipled", "Volume")
+    shader.inputs["Density"].default_value = density
+    shader.inputs["Density Attribute"].default_value = ""  # no density grid: uniform
+    tree = mat.node_tree
+    attr = tree.nodes.new("ShaderNodeAttribute")
+    attr.attribute_name = "color"
+    attr.location = (-500, 100)
+    colour = attr.outputs["Color"]
+    if srgb:
+        gamma = tree.nodes.new("ShaderNodeGamma")
+        gamma.inputs["Gamma"].default_value = 2.2
+        gamma.location = (-250, 100)
+        tree.links.new(colour, gamma.inputs["Color"])
+        colour = gamma.outputs["Color"]
+    tree.links.new(colour, shader.inputs["Color"])
+    return mat
+
+
+def image_material(name, image, uv_map, created, alpha=False):
+    """A new material: the image over UV map `uv_map` as the base colour
+    (and its alpha as alpha with `alpha`)."""
+    mat = created.add(bpy.data.materials.new(name))
+    shader = _output_with(mat, "ShaderNodeBsdfPrincipled", "Surface")
+    shader.inputs["Roughness"].default_value = 0.5
+    tree = mat.node_tree
+    tex = tree.nodes.new("ShaderNodeTexImage")
+    tex.image = image
+    tex.interpolation = 'Linear'
+    tex.location = (-400, 0)
+    uv = tree.nodes.new("ShaderNodeUVMap")
+    uv.uv_map = uv_map
+    uv.location = (-650, -100)
+    tree.links.new(uv.outputs["UV"], tex.inputs["Vector"])
+    tree.links.new(tex.outputs["Color"], shader.inputs["Base Color"])
+    if alpha:
+        tree.links.new(tex.outputs["Alpha"], shader.inputs["Alpha"])
+    return mat
+
+
+def attribute_material(name, attribute, created):
+    """A new material: colour attribute `attribute` as the base colour."""
+    mat = created.add(bpy.data.materials.new(name))
+    shader = _output_with(mat, "ShaderNodeBsdfPrincipled", "Surface")
+    shader.inputs["Roughness"].default_value = 0.5
+    tree = mat.node_tree
+    attr = tree.nodes.new("ShaderNodeVertexColor")
+    attr.layer_name = attribute
+    attr.location = (-400, 0)
+    tree.links.new(attr.outputs["Color"], shader.inputs["Base Color"])
+    return mat

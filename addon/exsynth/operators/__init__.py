@@ -1,6 +1,6 @@
 # SPDX-License-Identifier: GPL-3.0-or-later
 """Operators: thin wrappers that collect inputs, run a job (jobs.py), build results."""
 
-from . import voxelize
+from . import solid, voxelize
 
-CLASSES = (*voxelize.CLASSES,)
+CLASSES = (*voxelize.CLASSES, *solid.CLASSES)

@@ -13,6 +13,11 @@ ExemplarIndex::ExemplarIndex(const Image& image, int n, double pca_variance, int
     : image_(image), n_(n), vw_(image.width() - n + 1), vh_(image.height() - n + 1), bins_(bins) {
   build_neighbourhoods();
   pca_ = search::fit_pca(neigh_, pca_variance, max_pca_dims);
+  // Zero columns up to a multiple of 8: coefficients then compare in whole
+  // 8-float SIMD blocks, and the zeros add nothing to any distance.
+  const Eigen::Index d = pca_.basis.cols(), padded = (d + 7) / 8 * 8;
+  pca_.basis.conservativeResize(Eigen::NoChange, padded);
+  pca_.basis.rightCols(padded - d).setZero();
   coeffs_ = pca_.project(neigh_);
   if (coherence_k > 0) build_coherence(coherence_k, progress);
 

@@ -126,10 +126,20 @@ double LevelSolver::search(int iteration, bool exhaustive, StageProgress& progre
     // the result does not depend on the order chunks run in.
     std::vector<std::int32_t> next(w.size());
     std::vector<float> energy(w.size());
+    // Visit order: for the x-view the slice axis x is the volume's unit
+    // stride, so walking along it first lets consecutive gathers share cache
+    // lines (the other views already walk along x as their u axis).
+    const bool along_axis = kSlices[i].axis == 0;
+    auto sparse_of = [&](std::size_t k) -> std::size_t {
+      if (!along_axis) return k;
+      const std::size_t a = k % w.na, rest = k / w.na;  // rest = sv * nu + su
+      return std::size_t(a) * w.nv * w.nu + rest;
+    };
     const std::size_t batch = kBatch;
     const std::size_t batches = (w.size() + batch - 1) / batch;
     parallel_chunks(batches, 1, progress, [&](std::size_t b0, std::size_t b1) {
       RowMatrixXf x(batch, D);
+      std::vector<std::size_t> order(batch);
       std::vector<int> cand;
       // stamp[j] = the last query that proposed candidate j: O(1) dedupe.
       // Coherent neighbours mostly propose the same candidates.
@@ -137,11 +147,12 @@ double LevelSolver::search(int iteration, bool exhaustive, StageProgress& progre
       std::uint32_t query = 0;
       for (std::size_t b = b0; b < b1; ++b) {
         const std::size_t first = b * batch, rows = std::min(batch, w.size() - first);
-        for (std::size_t k = 0; k < rows; ++k) gather(i, first + k, x.row(Eigen::Index(k)).data());
+        for (std::size_t k = 0; k < rows; ++k) order[k] = sparse_of(first + k);
+        for (std::size_t k = 0; k < rows; ++k) gather(i, order[k], x.row(Eigen::Index(k)).data());
         RowMatrixXf y;
         if (opt_.search != SolidSearch::Exact) y = ex.pca().project(x.topRows(Eigen::Index(rows)));
         for (std::size_t k = 0; k < rows; ++k) {
-          const std::size_t sp = first + k;
+          const std::size_t sp = order[k];
           int best = -1;
           if (opt_.search == SolidSearch::Exact) {
             float bd = std::numeric_limits<float>::max();
@@ -185,8 +196,10 @@ double LevelSolver::search(int iteration, bool exhaustive, StageProgress& progre
               }
             IndexRng rng(seed_, sp, std::uint64_t(iteration) * 3 + i);
             for (int q = 0; q < opt_.random_candidates || cand.empty(); ++q) cand.push_back(int(rng.below(ex.count())));
-            // Partial distances: most candidates lose within the first
-            // (highest-variance) PCA dimensions, so stop as soon as they do.
+            // Partial distances over 8-float blocks (the PCA space is padded
+            // to a multiple of 8): most candidates lose within the first,
+            // highest-variance dimensions, so stop as soon as they do.
+            using Block = Eigen::Matrix<float, 8, 1>;
             float bd = std::numeric_limits<float>::max();
             const int d = int(y.cols());
             const float* q = y.row(Eigen::Index(k)).data();
@@ -194,10 +207,8 @@ double LevelSolver::search(int iteration, bool exhaustive, StageProgress& progre
               const float* e = ex.coefficients().row(c).data();
               float acc = 0.0f;
               int t = 0;
-              for (; t < d && acc < bd; t += 4) {
-                const int end = std::min(d, t + 4);
-                for (int u = t; u < end; ++u) acc += (e[u] - q[u]) * (e[u] - q[u]);
-              }
+              for (; t < d && acc < bd; t += 8)
+                acc += (Eigen::Map<const Block>(e + t) - Eigen::Map<const Block>(q + t)).squaredNorm();
               if (t >= d && acc < bd) bd = acc, best = c;
             }
           }

@@ -215,8 +215,10 @@ TextureResult optimize_texture(const Job& job, const TextureOptimizationOptions&
     for (int it = 0; it < iterations; ++it) {
       // The coarsest level has no coherent matches to start from and is
       // small: search it exhaustively (in PCA space) until matches settle.
+      if (ctx) ctx->set_stage(stage + " search");
       result.energy.push_back(solver->search(it, coarsest && it < 2, progress));
       result.energy_level.push_back(l);
+      if (ctx) ctx->set_stage(stage + " optimise");
       solver->optimize(it, progress);
     }
     previous = std::move(solver);

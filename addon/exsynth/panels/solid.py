@@ -1,0 +1,97 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
+"""Solid Texture in the "ExSynth" sidebar tab: exemplars, synthesis, bake, Re-bake."""
+
+import bpy
+
+from .main import CATEGORY
+
+
+class _Panel:
+    bl_space_type = 'VIEW_3D'
+    bl_region_type = 'UI'
+    bl_category = CATEGORY
+
+    def _layout(self):
+        layout = self.layout
+        layout.use_property_split = True
+        layout.use_property_decorate = False
+        return layout
+
+
+class EXSYNTH_PT_solid(_Panel, bpy.types.Panel):
+    bl_label = "Solid Texture"
+
+    def draw(self, context):
+        layout = self._layout()
+        settings = context.scene.exsynth
+
+        layout.template_ID(settings, "solid_exemplar", open="image.open")
+        image = settings.solid_exemplar
+        if image is not None and image.has_data:  # has_data: drawing must not load files
+            kind = "float" if image.is_float else "8-bit"
+            layout.label(text=f"{image.size[0]} × {image.size[1]} px, {kind}", icon='IMAGE_DATA')
+
+        col = layout.column()
+        col.prop(settings, "solid_size")
+        col.prop(settings, "solid_scale")
+        col.prop(settings, "solid_levels")
+        col.prop(settings, "solid_iterations")
+        col.prop(settings, "solid_use_alpha")
+
+        col = layout.column()
+        col.prop(settings, "solid_bake_target")
+        if settings.solid_bake_target == 'IMAGE':
+            col.prop(settings, "solid_bake_resolution")
+
+        meshes = [o for o in context.selected_objects if o.type == 'MESH']
+        box = layout.box()
+        if not meshes:
+            box.label(text="Select the mesh(es) to bake onto", icon='INFO')
+        else:
+            extra = f" and {len(meshes) - 1} more" if len(meshes) > 1 else ""
+            box.label(text=f"{meshes[0].name}{extra}", icon='MESH_DATA')
+            n = settings.solid_size
+            box.label(text=f"{n}³ voxels, {settings.solid_scale / n:.3g} each")
+        row = layout.row()
+        row.scale_y = 1.4
+        row.operator("exsynth.solid_texture", icon='TEXTURE')
+
+
+class EXSYNTH_PT_solid_axes(_Panel, bpy.types.Panel):
+    bl_label = "Per-Axis Exemplars"
+    bl_parent_id = "EXSYNTH_PT_solid"
+    bl_options = {'DEFAULT_CLOSED'}
+
+    def draw(self, context):
+        layout = self._layout()
+        settings = context.scene.exsynth
+        layout.label(text="Empty: the main exemplar", icon='INFO')
+        layout.prop(settings, "solid_exemplar_y", text="Y (XZ slices)")
+        layout.prop(settings, "solid_exemplar_z", text="Z (XY slices)")
+
+
+class EXSYNTH_PT_solid_rebake(_Panel, bpy.types.Panel):
+    bl_label = "Re-bake"
+    bl_parent_id = "EXSYNTH_PT_solid"
+
+    def draw(self, context):
+        layout = self._layout()
+        settings = context.scene.exsynth
+        layout.prop(settings, "solid_volume")
+        layout.operator("exsynth.solid_rebake", icon='FILE_REFRESH')
+
+
+class EXSYNTH_PT_solid_advanced(_Panel, bpy.types.Panel):
+    bl_label = "Advanced"
+    bl_parent_id = "EXSYNTH_PT_solid"
+    bl_options = {'DEFAULT_CLOSED'}
+
+    def draw(self, context):
+        layout = self._layout()
+        settings = context.scene.exsynth
+        layout.prop(settings, "seed")
+        layout.prop(settings, "memory_budget_gib", text="Memory Budget (GiB)")
+        layout.label(text="Shared with Voxelize", icon='LINKED')
+
+
+CLASSES = (EXSYNTH_PT_solid, EXSYNTH_PT_solid_axes, EXSYNTH_PT_solid_rebake, EXSYNTH_PT_solid_advanced)

@@ -1,0 +1,68 @@
+#!/usr/bin/env python3
+"""Solid and 2D texture synthesis benchmarks on the bundled exemplars.
+
+Each case runs in its own process (so its peak RSS is its own) and prints
+one table row: wall time, peak memory and the final texture energy (mean
+|s - e|^0.8 per matched 8x8 neighbourhood, lower = closer to the exemplar),
+so speed and quality are read together.
+
+usage: bench_solid.py --build BUILD_DIR [--cases solid128,solid256,image256]
+"""
+import argparse
+import json
+import os
+import subprocess
+import sys
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+EXEMPLAR = os.path.join(ROOT, "assets", "textures", "crackedground.png")  # 128 x 128 RGB
+
+CASES = {
+    # name: (description, python statement producing `res` from `ex`)
+    "solid128": ("solid 128^3 RGB, 3 levels", "res = _native.synthesize_solid(ex, size=128, levels=3, seed=1)"),
+    "solid256": ("solid 256^3 RGB, 3 levels", "res = _native.synthesize_solid(ex, size=256, levels=3, seed=1)"),
+    "image256": ("image 128^2 -> 256^2, 3 levels", "res = _native.synthesize_image(ex, width=256, height=256, seed=1)"),
+}
+
+CHILD = """
+import json, sys, time
+import numpy as np
+from PIL import Image
+from exsynth import _native
+ex = np.asarray(Image.open(sys.argv[1]).convert("RGB"))
+t = time.perf_counter()
+{stmt}
+dt = time.perf_counter() - t
+print(json.dumps({{"seconds": dt, "energy": res["energy"][-1]}}))
+"""
+
+
+def run_case(build, stmt):
+    env = dict(os.environ, PYTHONPATH=os.path.join(build, "addon"))
+    proc = subprocess.Popen(["/usr/bin/python3", "-c", CHILD.format(stmt=stmt), EXEMPLAR],
+                            stdout=subprocess.PIPE, env=env, text=True)
+    out = proc.stdout.read()
+    _, status, usage = os.wait4(proc.pid, 0)
+    if os.waitstatus_to_exitcode(status) != 0:
+        raise SystemExit(f"benchmark case failed: {stmt}")
+    return json.loads(out.strip().splitlines()[-1]), usage.ru_maxrss / 1024.0
+
+
+def main(argv=None):
+    ap = argparse.ArgumentParser(description=__doc__)
+    ap.add_argument("--build", required=True)
+    ap.add_argument("--cases", default=",".join(CASES))
+    args = ap.parse_args(argv)
+    print(f"machine: {os.cpu_count()} cores; exemplar {os.path.relpath(EXEMPLAR, ROOT)}; one process per row")
+    header = f"{'case':<34} {'seconds':>8} {'peak RSS':>10} {'energy':>8}"
+    print(header)
+    print("-" * len(header))
+    for name in args.cases.split(","):
+        desc, stmt = CASES[name]
+        r, rss = run_case(args.build, stmt)
+        print(f"{desc:<34} {r['seconds']:>8.2f} {rss:>7.0f}MiB {r['energy']:>8.3f}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
