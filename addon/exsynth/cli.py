@@ -14,7 +14,10 @@ import bpy
 import numpy as np
 
 from . import _native, jobs
+from .io import bake as bake_io
+from .io import image as image_io
 from .io import mesh as mesh_io
+from .operators import solid as solid_ops
 from .operators.voxelize import VoxelizeJob
 from .properties import GIB
 
@@ -70,12 +73,58 @@ def _parser():
                    help="refuse jobs needing more than this many GiB (default: the engine's 8 GiB)")
     p.set_defaults(run=_run_voxelize)
 
-    p = sub.add_parser("demo", help="voxelize the bundled bunny and render PNGs",
-                       description="Voxelize assets/meshes/bunny.obj and render it with Cycles.")
+    p = sub.add_parser(
+        "solid", help="2D exemplar(s) -> solid texture (.vdb or .npy), optionally baked onto a mesh",
+        description="Synthesize a tiling solid texture (Kopf et al. 2007) from exemplar images, as the "
+        "Solid Texture operator does; with --mesh also bake it onto the mesh's UV map.",
+    )
+    p.add_argument("--exemplar", required=True, help="exemplar image (any format Blender reads)")
+    p.add_argument("--exemplar-y", help="exemplar of the slices across Y (default: --exemplar)")
+    p.add_argument("--exemplar-z", help="exemplar of the slices across Z (default: --exemplar)")
+    p.add_argument("--size", type=int, default=64, help="voxels along each edge of the solid (default 64)")
+    p.add_argument("--out", required=True,
+                   help=".vdb (grid color, + alpha with --alpha) or .npy ((Z, Y, X, C) float32)")
+    p.add_argument("--levels", type=int, default=3, help="coarse-to-fine levels (default 3)")
+    p.add_argument("--iterations", type=int, default=3, help="optimisation rounds per level (default 3)")
+    p.add_argument("--seed", type=int, default=0, help="random seed (default 0)")
+    p.add_argument("--alpha", action="store_true", help="synthesize the exemplars' alpha as a 4th channel")
+    p.add_argument("--scale", type=float, default=0.0,
+                   help="edge length of one tile in mesh units (default: the mesh's longest side, "
+                   "or 1 without --mesh); sets the .vdb's voxel size")
+    p.add_argument("--mesh", help="also bake the solid onto this mesh (.obj, .ply, .stl; unwrapped with "
+                   "Smart UV Project when it has no UVs)")
+    p.add_argument("--bake-out", help="the baked texture (.png), with --mesh")
+    p.add_argument("--bake-size", type=int, default=512, help="baked texture width and height (default 512)")
+    p.add_argument("--mesh-out", help="with --mesh: write the mesh with the UV map the bake used (.obj)")
+    p.add_argument("--memory-budget", type=float, default=0.0,
+                   help="refuse jobs needing more than this many GiB (default: the engine's 8 GiB)")
+    p.set_defaults(run=_run_solid)
+
+    p = sub.add_parser(
+        "image", help="2D exemplar -> larger (optionally tileable) image",
+        description="2D texture synthesis with the solid engine's optimiser.",
+    )
+    p.add_argument("--exemplar", required=True, help="exemplar image (any format Blender reads)")
+    p.add_argument("--width", type=int, required=True, help="output width in pixels")
+    p.add_argument("--height", type=int, required=True, help="output height in pixels")
+    p.add_argument("--out", required=True, help="output image (.png)")
+    p.add_argument("--tileable", action="store_true", help="make the output tile (opposite edges continue)")
+    p.add_argument("--levels", type=int, default=3, help="coarse-to-fine levels (default 3)")
+    p.add_argument("--iterations", type=int, default=3, help="optimisation rounds per level (default 3)")
+    p.add_argument("--seed", type=int, default=0, help="random seed (default 0)")
+    p.add_argument("--alpha", action="store_true", help="synthesize the exemplar's alpha too")
+    p.add_argument("--memory-budget", type=float, default=0.0,
+                   help="refuse jobs needing more than this many GiB (default: the engine's 8 GiB)")
+    p.set_defaults(run=_run_image)
+
+    p = sub.add_parser("demo", help="voxelize the bundled bunny, solid-texture the cow; render PNGs",
+                       description="Voxelize assets/meshes/bunny.obj, solid-texture assets/meshes/cow.obj "
+                       "cut open, and render them with Cycles.")
     p.add_argument("--assets", required=True, help="the repository's assets/ folder")
     p.add_argument("--out", required=True, help="folder for the PNGs")
     p.add_argument("--resolution", type=int, default=96, help="voxels along the longest side (default 96)")
     p.add_argument("--samples", type=int, default=16, help="Cycles samples per pixel (default 16)")
+    p.add_argument("--solid-size", type=int, default=64, help="voxels along the solid's edge (default 64)")
     p.set_defaults(run=_run_demo)
     return parser
 
@@ -122,6 +171,113 @@ def _run_voxelize(args):
     return 0
 
 
+# ---- solid and image ----------------------------------------------------------------
+def _run_solid(args):
+    out_ext = _extension("--out", args.out, VOXEL_FORMATS)
+    paths = [_input_file("--exemplar", args.exemplar, None)]
+    for arg, path in (("--exemplar-y", args.exemplar_y), ("--exemplar-z", args.exemplar_z)):
+        paths.append(_input_file(arg, path, None) if path else None)
+    _require(args.size > 0, f"--size must be > 0 (got {args.size})")
+    _require(args.levels > 0, f"--levels must be > 0 (got {args.levels})")
+    _require(args.iterations > 0, f"--iterations must be > 0 (got {args.iterations})")
+    _require(args.scale >= 0, f"--scale must be >= 0 (got {args.scale}); 0 picks it from the mesh")
+    _require(args.memory_budget >= 0, f"--memory-budget must be >= 0 GiB (got {args.memory_budget})")
+    _require(bool(args.mesh) == bool(args.bake_out), "--mesh and --bake-out go together")
+    _require(not args.mesh_out or args.mesh, "--mesh-out needs --mesh")
+    if args.mesh:
+        mesh_path = _input_file("--mesh", args.mesh, MESH_FORMATS)
+        _extension("--bake-out", args.bake_out, (".png",))
+        _require(args.bake_size > 0, f"--bake-size must be > 0 (got {args.bake_size})")
+    if args.mesh_out:
+        _extension("--mesh-out", args.mesh_out, (".obj",))
+
+    images = [image_io.load(p) if p else None for p in paths]
+    exemplar, exemplar_y, exemplar_z, encoding = solid_ops.read_exemplars(*images, use_alpha=args.alpha)
+    scale, anchor, targets, obj = args.scale or 1.0, np.zeros(3), [], None
+    if args.mesh:
+        obj = _single_mesh(import_mesh(mesh_path), mesh_path)
+        anchor, upper = bake_io.world_bounds([obj])
+        scale = args.scale or float(np.max(upper - anchor)) or 1.0
+        targets = bake_io.collect(bpy.context, [obj], bake_io.IMAGE, solid_ops.translation(-anchor))
+    job = solid_ops.SolidJob(
+        name=solid_ops.exemplar_name(images[0]), exemplar=exemplar, exemplar_y=exemplar_y,
+        exemplar_z=exemplar_z, size=args.size, levels=args.levels, iterations=args.iterations,
+        scale=scale, seed=args.seed, memory_budget=int(args.memory_budget * GIB), encoding=encoding,
+        anchor=anchor, targets=targets, bake=solid_ops.BakeOptions(args.bake_size),
+    )
+    runner = jobs.Runner(job)
+    runner.run_here()
+    result = runner.outcome()
+    solid = result.solid
+
+    _make_parent(args.out)
+    if out_ext == ".vdb":
+        _native.write_vdb(args.out, solid_ops.solid_grids(solid.values), solid.origin, solid.voxel_size)
+    else:
+        np.save(args.out, np.ascontiguousarray(solid.values, np.float32))
+    n, c = solid.size, solid.values.shape[3]
+    energy = f", final energy {solid.energy[-1]:.4g}" if solid.energy else ""
+    line = (f"solid: {n}x{n}x{n} voxels x {c} channels of {solid.voxel_size:.6g} from "
+            f"{os.path.basename(paths[0])} in {runner.seconds:.2f} s{energy} -> {args.out}")
+    if args.mesh:
+        baked = result.baked[0]
+        _make_parent(args.bake_out)
+        image_io.save_png(args.bake_out, baked.pixels, encoding)
+        line += f", {args.bake_size}² texture ({100 * baked.covered:.0f} % covered) -> {args.bake_out}"
+        if args.mesh_out:
+            bake_io.apply_uvs(obj, baked.target, jobs.Created())
+            _make_parent(args.mesh_out)
+            export_selected_obj(args.mesh_out, obj, uvs=True)
+            line += f", mesh -> {args.mesh_out}"
+    print(line)
+    return 0
+
+
+def _run_image(args):
+    exemplar_path = _input_file("--exemplar", args.exemplar, None)
+    _extension("--out", args.out, (".png",))
+    _require(args.width > 0 and args.height > 0,
+             f"--width and --height must be > 0 (got {args.width}x{args.height})")
+    _require(args.levels > 0, f"--levels must be > 0 (got {args.levels})")
+    _require(args.iterations > 0, f"--iterations must be > 0 (got {args.iterations})")
+    _require(args.memory_budget >= 0, f"--memory-budget must be >= 0 GiB (got {args.memory_budget})")
+
+    image = image_io.load(exemplar_path)
+    exemplar, _, _, encoding = solid_ops.read_exemplars(image, use_alpha=args.alpha)
+    job = solid_ops.ImageJob(
+        exemplar=exemplar, width=args.width, height=args.height, tileable=args.tileable,
+        levels=args.levels, iterations=args.iterations, seed=args.seed,
+        memory_budget=int(args.memory_budget * GIB),
+    )
+    runner = jobs.Runner(job)
+    runner.run_here()
+    pixels = runner.outcome()
+    _make_parent(args.out)
+    image_io.save_png(args.out, pixels[::-1], encoding)  # the engine's row 0 is the top
+    tile = ", tileable" if args.tileable else ""
+    print(f"image: {args.width}x{args.height}{tile} from {os.path.basename(exemplar_path)} "
+          f"in {runner.seconds:.2f} s -> {args.out}")
+    return 0
+
+
+def _single_mesh(objects, path):
+    """The imported objects as one mesh object (joined when the file has several)."""
+    if not objects:
+        raise UsageError(f"--mesh: {path} holds no mesh")
+    if len(objects) > 1:
+        with bpy.context.temp_override(active_object=objects[0], object=objects[0],
+                                       selected_objects=objects, selected_editable_objects=objects):
+            bpy.ops.object.join()
+    obj = objects[0]
+    if len(obj.data.polygons) == 0:
+        raise UsageError(f"--mesh: {path} has no faces to bake onto")
+    bpy.context.view_layer.objects.active = obj
+    for other in list(bpy.context.view_layer.objects.selected):
+        other.select_set(False)
+    obj.select_set(True)
+    return obj
+
+
 def import_mesh(path):
     """Import a mesh file without axis conversion; returns the new mesh objects."""
     before = {o.name for o in bpy.data.objects}
@@ -141,11 +297,15 @@ def export_obj(path, name, vertices, triangles):
     same (unconverted) axes the input was read in."""
     obj = bpy.data.objects.new(name, mesh_io.new_mesh(name, vertices, triangles))
     bpy.context.scene.collection.objects.link(obj)
+    export_selected_obj(path, obj)
+
+
+def export_selected_obj(path, obj, uvs=False):
     for other in list(bpy.context.view_layer.objects.selected):
         other.select_set(False)
     obj.select_set(True)
     bpy.ops.wm.obj_export(filepath=path, export_selected_objects=True, forward_axis='Y',
-                          up_axis='Z', export_materials=False, export_uv=False)
+                          up_axis='Z', export_materials=False, export_uv=uvs)
 
 
 def _enable_bundled_addon(name):
@@ -161,10 +321,14 @@ def _run_demo(args):
     from . import demo
 
     bunny = _input_file("--assets", os.path.join(args.assets, "meshes", "bunny.obj"), (".obj",))
+    cow = _input_file("--assets", os.path.join(args.assets, "meshes", "cow.obj"), (".obj",))
+    wood = _input_file("--assets", os.path.join(args.assets, "textures", "drkwood2.png"), None)
     _require(args.resolution > 0, f"--resolution must be > 0 (got {args.resolution})")
     _require(args.samples > 0, f"--samples must be > 0 (got {args.samples})")
+    _require(args.solid_size > 0, f"--solid-size must be > 0 (got {args.solid_size})")
     os.makedirs(args.out, exist_ok=True)
-    return demo.run(bunny, args.out, resolution=args.resolution, samples=args.samples)
+    return (demo.run(bunny, args.out, resolution=args.resolution, samples=args.samples)
+            or demo.run_solid(cow, wood, args.out, size=args.solid_size, samples=args.samples))
 
 
 # ---- argument checks ----------------------------------------------------------
@@ -180,9 +344,11 @@ def _extension(arg, path, allowed):
 
 
 def _input_file(arg, path, allowed):
+    """An existing file; `allowed` extensions (None: any, e.g. images Blender reads)."""
     path = os.path.abspath(path)
     _require(os.path.isfile(path), f"{arg}: no such file: {path}")
-    _extension(arg, path, allowed)
+    if allowed is not None:
+        _extension(arg, path, allowed)
     return path
 
 

@@ -66,6 +66,105 @@ def run(bunny_path, out_dir, resolution=96, samples=16):
     return 0
 
 
+COW_LENGTH = 2.0  # the OBJ is 1 unit long
+SOLID_SCALE = 1.0  # one tile of the solid, in world units
+
+
+def run_solid(cow_path, exemplar_path, out_dir, size=64, samples=16):
+    """Solid-texture the bundled cow, cut open: the Solid Texture operator on
+    the cow minus a box, Re-bake on the piece the box took out (lifted off),
+    so the cut faces of both show the inside of the same block of wood."""
+    t0 = time.perf_counter()
+    bpy.ops.wm.read_homefile(use_empty=True)
+    _ensure_addon()
+    scene = bpy.context.scene
+    view_layer = bpy.context.view_layer
+
+    # The OBJ importer turns the file's Y-up into Blender's Z-up (as the
+    # object's rotation: dimensions are right after a view-layer update).
+    bpy.ops.wm.obj_import(filepath=cow_path)
+    cow = view_layer.objects.active
+    cow.name = "Cow"
+    view_layer.update()
+    cow.scale = [COW_LENGTH / cow.dimensions.x] * 3
+    view_layer.update()
+    corners = (np.array(cow.matrix_world) @ np.c_[np.array(cow.bound_box), np.ones(8)].T)[:3]
+    lo, hi = corners.min(axis=1), corners.max(axis=1)
+    cow.location -= Vector((0.5 * (lo[0] + hi[0]), 0.5 * (lo[1] + hi[1]), lo[2]))  # on the floor
+    _smooth(cow.data)
+    view_layer.update()
+
+    # A box over the front half of the back, on the camera's side: the cut
+    # shows the inside of the body from the shoulders to the neck.
+    dims = Vector(hi - lo)  # world extents (obj.dimensions ignores the importer's rotation)
+    box = bpy.data.objects.new("Cut", mesh_io.new_mesh("Cut", *_box()))
+    scene.collection.objects.link(box)
+    box.location = (0.22 * dims.x, -0.38 * dims.y, 0.8 * dims.z)
+    box.scale = (0.3 * dims.x, 0.4 * dims.y, 0.38 * dims.z)
+    box.rotation_euler = (0.0, math.radians(-10), math.radians(8))
+    piece = cow.copy()
+    piece.data = cow.data.copy()
+    piece.name = piece.data.name = "Cow piece"
+    scene.collection.objects.link(piece)
+    _boolean(cow, box, 'DIFFERENCE')
+    _boolean(piece, box, 'INTERSECT')
+    bpy.data.batch_remove([box, box.data])
+
+    exemplar = bpy.data.images.load(exemplar_path)
+    settings = scene.exsynth
+    settings.solid_exemplar = exemplar
+    settings.solid_size = size
+    settings.solid_scale = SOLID_SCALE
+    settings.solid_bake_resolution = 1024
+    t1 = time.perf_counter()
+    _select([cow])
+    result = bpy.ops.exsynth.solid_texture()
+    if result != {'FINISHED'}:
+        raise RuntimeError(f"exsynth.solid_texture returned {result}")
+    t2 = time.perf_counter()
+    _select([piece])
+    result = bpy.ops.exsynth.solid_rebake()  # the solid Solid Texture just made
+    if result != {'FINISHED'}:
+        raise RuntimeError(f"exsynth.solid_rebake returned {result}")
+    t3 = time.perf_counter()
+    # Lift the piece off (the texture is baked: it moves with it).
+    piece.location += Vector((0.1 * dims.x, -0.9 * dims.y, 0.25 * dims.z))
+
+    _stage(scene, samples)
+    centre = Vector((0.0, 0.0, 0.45 * dims.z))
+    _aim_camera(scene, centre, distance=4.6, side=0.45)
+    _render(scene, os.path.join(out_dir, "solid_texture.png"))
+    t4 = time.perf_counter()
+    print(f"demo: solid {size}³ from {os.path.basename(exemplar_path)} and bake in {t2 - t1:.2f} s, "
+          f"re-bake {t3 - t2:.2f} s; render {t4 - t3:.1f} s; total {t4 - t0:.1f} s -> {out_dir}")
+    return 0
+
+
+def _box():
+    corners = np.array([[x, y, z] for z in (-1, 1) for y in (-1, 1) for x in (-1, 1)], np.float32)
+    quads = [(0, 2, 3, 1), (4, 5, 7, 6), (0, 1, 5, 4), (2, 6, 7, 3), (0, 4, 6, 2), (1, 3, 7, 5)]
+    tris = [t for a, b, c, d in quads for t in ((a, b, c), (a, c, d))]
+    return corners, np.array(tris, np.int32)
+
+
+def _boolean(obj, cutter, operation):
+    mod = obj.modifiers.new("Cut", 'BOOLEAN')
+    mod.object = cutter
+    mod.operation = operation
+    mod.solver = 'EXACT'
+    with bpy.context.temp_override(object=obj, active_object=obj):
+        bpy.ops.object.modifier_apply(modifier=mod.name)
+
+
+def _select(objects):
+    view_layer = bpy.context.view_layer
+    for other in list(view_layer.objects.selected):
+        other.select_set(False)
+    for obj in objects:
+        obj.select_set(True)
+    view_layer.objects.active = objects[0]
+
+
 def _ensure_addon():
     if hasattr(bpy.types, "EXSYNTH_OT_voxelize"):
         return

@@ -62,6 +62,7 @@ void set_common(TextureOptimizationOptions& o, const py::kwargs& kw) {
     else if (k == "histogram_matching") o.histogram_matching = v.cast<bool>();
     else if (k == "histogram_bins") o.histogram_bins = v.cast<int>();
     else if (k == "mean_shift") o.mean_shift = v.cast<bool>();
+    else if (k == "feature_weight") o.feature_weight = v.cast<double>();
     else if (k == "tileable") o.tileable = v.cast<bool>();
     else if (k == "memory_budget") o.memory_budget = v.cast<std::size_t>() ? v.cast<std::size_t>() : kDefaultMemoryBudget;
     else if (k == "seed") o.seed = v.cast<std::uint64_t>();
@@ -69,7 +70,7 @@ void set_common(TextureOptimizationOptions& o, const py::kwargs& kw) {
       throw InvalidInput("unknown option '" + k +
                          "'; options: levels, neighborhood, iterations, r, pca_variance, max_pca_dims, search, "
                          "coherence_k, random_candidates, ann_eps, histogram_matching, histogram_bins, mean_shift, "
-                         "tileable, memory_budget, seed");
+                         "feature_weight, tileable, memory_budget, seed");
   }
 }
 
@@ -122,7 +123,8 @@ views: active slices, 'xyz' or two of them. constraint: (size, size, size, C + 1
 target values then a weight in [0, 1]. Options (keywords): levels=3, neighborhood=8,
 iterations=3, r=0.8, pca_variance=0.95, max_pca_dims=32, search='kcoherence'|'kdtree'|'exact',
 coherence_k=4, random_candidates=2, ann_eps=2.0, histogram_matching=True, histogram_bins=16,
-mean_shift=False, tileable=True, memory_budget=0 (default), seed=0.
+mean_shift=False, feature_weight=0 (> 0: feature-distance channel), tileable=True,
+memory_budget=0 (default), seed=0.
 Returns {'solid': (Z, Y, X, C) float32, 'energy': [...], 'energy_level': [...]}.)doc");
 
   m.def(

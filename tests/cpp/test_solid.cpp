@@ -294,3 +294,33 @@ TEST(Image2D, SynthesisesTheRequestedSizeAndTiles) {
   as_volume.values() = out.values();
   EXPECT_LT(slice_to_exemplar_distance(as_volume, 2, ex), 0.5 * slice_to_exemplar_distance(shuffled(as_volume), 2, ex));
 }
+
+#include "solid/feature_channel.hpp"
+
+TEST(FeatureChannel, SignedDistanceToTheDarkFeaturesEdge) {
+  // A dark 10x10 square (the feature) on a light 40x40 image.
+  Image img(40, 40, 3, 0.9f);
+  for (int y = 15; y < 25; ++y)
+    for (int x = 15; x < 25; ++x)
+      for (int c = 0; c < 3; ++c) img.at(x, y, c) = 0.1f;
+  const Image f = solid::with_feature_channel(img, 2.0f, 8);
+  ASSERT_EQ(f.channels(), 4);
+  EXPECT_FLOAT_EQ(f.at(3, 3, 0), 0.9f);                      // colours kept
+  EXPECT_FLOAT_EQ(f.at(20, 20, 3), 2.0f * (0.5f - 0.5f * 5.0f / 8.0f));  // 5 px inside the feature
+  EXPECT_FLOAT_EQ(f.at(2, 20, 3), 2.0f);                     // 13 px outside: clamped at +1
+  EXPECT_FLOAT_EQ(f.at(10, 20, 3), 2.0f * (0.5f + 0.5f * 5.0f / 8.0f));  // 5 px outside (nearest feature pixel x = 15)
+}
+
+TEST(Solid, FeatureChannelGuidesMatchingAndIsDropped) {
+  const Image ex = disc_texture(32, 32, 3, 15);
+  SolidOptions o = small_options();
+  o.feature_weight = 1.0;
+  const TextureResult r = synthesize_solid(one_exemplar(ex), o);
+  EXPECT_EQ(r.texture.channels(), 3);
+  const Volume baseline = shuffled(r.texture);
+  for (int axis = 0; axis < 3; ++axis)
+    EXPECT_LT(slice_to_exemplar_distance(r.texture, axis, ex), 0.5 * slice_to_exemplar_distance(baseline, axis, ex));
+  SolidExemplars constrained = one_exemplar(ex);
+  constrained.constraint = Volume(o.size, o.size, o.size, 4);
+  EXPECT_THROW(synthesize_solid(constrained, o), InvalidInput);
+}

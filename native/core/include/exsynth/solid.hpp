@@ -42,6 +42,10 @@ struct TextureOptimizationOptions {
   bool histogram_matching = true;
   int histogram_bins = 16;       ///< per channel
   bool mean_shift = false;       ///< mean-shift mode of the contributions instead of the mean (sharper)
+  /// > 0: add the feature-distance channel (signed distance to the edges of
+  /// the exemplar's dark features) with this weight relative to colours in
+  /// [0, 1]; it guides matching and is dropped from the output. 0 = off.
+  double feature_weight = 0.0;
   bool tileable = true;          ///< toroidal boundaries, so the output tiles
   std::size_t memory_budget = kDefaultMemoryBudget;
   std::uint64_t seed = 0;

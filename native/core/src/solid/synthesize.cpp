@@ -11,6 +11,7 @@
 #include "exsynth/sample.hpp"
 #include "exsynth/solid.hpp"
 #include "solid/exemplar_index.hpp"
+#include "solid/feature_channel.hpp"
 #include "solid/level_solver.hpp"
 
 namespace exsynth {
@@ -35,6 +36,7 @@ void check_options(const TextureOptimizationOptions& o) {
   range("random_candidates", o.random_candidates, 0, 64, "");
   range("ann_eps", o.ann_eps, 0, 1e6, "");
   range("histogram_bins", o.histogram_bins, 2, 256, "");
+  range("feature_weight", o.feature_weight, 0, 100, " (0 = off)");
 }
 
 struct Dims {
@@ -93,6 +95,17 @@ TextureResult optimize_texture(const Job& job, const TextureOptimizationOptions&
     image_of[i] = int(it - images.begin());
   }
   if (images.empty()) throw InvalidInput("no exemplar: give at least one exemplar image and one active view");
+  const int user_channels = channels;
+  std::vector<Image> featured;  // exemplars with the feature-distance channel appended
+  if (opt.feature_weight > 0) {
+    if (job.constraint && !job.constraint->empty())
+      throw InvalidInput("the feature-distance channel cannot be combined with a constraint volume yet; "
+                         "set feature_weight=0 or drop the constraint");
+    featured.reserve(images.size());
+    for (const Image* img : images) featured.push_back(solid::with_feature_channel(*img, float(opt.feature_weight), n));
+    for (std::size_t e = 0; e < images.size(); ++e) images[e] = &featured[e];
+    ++channels;
+  }
 
   const std::vector<Dims> dims = level_dims(job.finest, L);
   for (int a = 0; a < 3; ++a)
@@ -225,6 +238,12 @@ TextureResult optimize_texture(const Job& job, const TextureOptimizationOptions&
     prev_index = std::move(index);  // the solver's views point into these
   }
   if (ctx) ctx->set_progress(1.0);
+  if (channels != user_channels) {  // drop the feature-distance channel
+    Volume out(tex.nx(), tex.ny(), tex.nz(), user_channels, 0.0f, tex.transform());
+    for (std::size_t v = 0; v < tex.voxel_count(); ++v)
+      std::copy(tex.data() + v * channels, tex.data() + v * channels + user_channels, out.data() + v * user_channels);
+    tex = std::move(out);
+  }
   result.texture = std::move(tex);
   return result;
 }
