@@ -156,7 +156,10 @@ VoxelizeResult voxelize(const TriangleMesh& input, const VoxelizeOptions& opt, E
         median[v] = std::max(std::min(x, y), std::min(std::max(x, y), z));
       }
     });
-    std::vector<float> blended(voxels);
+    // The blend goes into cov[0] in place: voxel v reads only its own
+    // coverages and its neighbours' medians. Reusing the buffer saves a
+    // fresh allocation's page faults (~10 % of the run at 256^3).
+    std::vector<float>& blended = cov[0];
     parallel_chunks(voxels, 1 << 14, vote, [&](std::size_t begin, std::size_t end) {
       for (std::size_t v = begin; v < end; ++v) {
         const float m = median[v];
@@ -181,7 +184,6 @@ VoxelizeResult voxelize(const TriangleMesh& input, const VoxelizeOptions& opt, E
     });
     result.density.values().swap(blended);
   }
-  for (auto& c : cov) std::vector<float>().swap(c);
   if (!opt.compute_sdf) {
     if (ctx) ctx->set_progress(1.0);
     return result;
@@ -189,7 +191,9 @@ VoxelizeResult voxelize(const TriangleMesh& input, const VoxelizeOptions& opt, E
 
   // Signed distance: exact narrow band -> feature transform carrying the
   // nearest triangle -> exact distance to that triangle everywhere.
-  std::vector<float> dist2;
+  std::vector<float> dist2 = std::move(cov[1]);  // already paged in
+  std::vector<float>().swap(cov[2]);
+  std::vector<float>().swap(cov[0]);
   std::vector<std::int32_t> label;
   {
     StageProgress band(ctx, "voxelize: narrow band", 0.55, 0.65, std::size_t(g.nz + 3) / 4);
