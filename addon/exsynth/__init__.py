@@ -13,7 +13,8 @@ bl_info = {
     "version": (0, 1, 0),
     "blender": (3, 4, 0),
     "location": "View3D > Sidebar > ExSynth",
-    "description": "Example-based texture and geometry synthesis (voxelize meshes into volumes)",
+    "description": "Example-based texture and geometry synthesis (voxelize meshes into volumes, "
+    "solid textures from 2D exemplars baked onto meshes)",
     "category": "ExSynth",
 }
 

@@ -322,13 +322,13 @@ def _run_demo(args):
 
     bunny = _input_file("--assets", os.path.join(args.assets, "meshes", "bunny.obj"), (".obj",))
     cow = _input_file("--assets", os.path.join(args.assets, "meshes", "cow.obj"), (".obj",))
-    wood = _input_file("--assets", os.path.join(args.assets, "textures", "drkwood2.png"), None)
+    stone = _input_file("--assets", os.path.join(args.assets, "textures", "crackedground.png"), None)
     _require(args.resolution > 0, f"--resolution must be > 0 (got {args.resolution})")
     _require(args.samples > 0, f"--samples must be > 0 (got {args.samples})")
     _require(args.solid_size > 0, f"--solid-size must be > 0 (got {args.solid_size})")
     os.makedirs(args.out, exist_ok=True)
     return (demo.run(bunny, args.out, resolution=args.resolution, samples=args.samples)
-            or demo.run_solid(cow, wood, args.out, size=args.solid_size, samples=args.samples))
+            or demo.run_solid(cow, stone, args.out, size=args.solid_size, samples=args.samples))
 
 
 # ---- argument checks ----------------------------------------------------------

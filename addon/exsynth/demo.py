@@ -1,6 +1,7 @@
 # SPDX-License-Identifier: GPL-3.0-or-later
 """`./exsynth demo`: voxelize the bundled bunny with the real operator and
-render the Volume and the rebuilt mesh with Cycles (CPU, small, fast)."""
+render the Volume and the rebuilt mesh; solid-texture the bundled cow, cut
+open, with Solid Texture and Re-bake. Cycles (CPU, small, fast)."""
 
 import math
 import os
@@ -72,8 +73,9 @@ SOLID_SCALE = 1.0  # one tile of the solid, in world units
 
 def run_solid(cow_path, exemplar_path, out_dir, size=64, samples=16):
     """Solid-texture the bundled cow, cut open: the Solid Texture operator on
-    the cow minus a box, Re-bake on the piece the box took out (lifted off),
-    so the cut faces of both show the inside of the same block of wood."""
+    the cow minus a box, Re-bake on the piece the box took out (then set
+    beside it, cut face to the camera), so the cut faces of both show the
+    inside of the same block of stone."""
     t0 = time.perf_counter()
     bpy.ops.wm.read_homefile(use_empty=True)
     _ensure_addon()
@@ -88,20 +90,19 @@ def run_solid(cow_path, exemplar_path, out_dir, size=64, samples=16):
     view_layer.update()
     cow.scale = [COW_LENGTH / cow.dimensions.x] * 3
     view_layer.update()
-    corners = (np.array(cow.matrix_world) @ np.c_[np.array(cow.bound_box), np.ones(8)].T)[:3]
-    lo, hi = corners.min(axis=1), corners.max(axis=1)
+    lo, hi = _world_bounds(cow)
     cow.location -= Vector((0.5 * (lo[0] + hi[0]), 0.5 * (lo[1] + hi[1]), lo[2]))  # on the floor
     _smooth(cow.data)
     view_layer.update()
 
-    # A box over the front half of the back, on the camera's side: the cut
-    # shows the inside of the body from the shoulders to the neck.
+    # A box over the middle of the back, on the camera's side: the cut shows
+    # the inside of the body.
     dims = Vector(hi - lo)  # world extents (obj.dimensions ignores the importer's rotation)
     box = bpy.data.objects.new("Cut", mesh_io.new_mesh("Cut", *_box()))
     scene.collection.objects.link(box)
-    box.location = (0.22 * dims.x, -0.38 * dims.y, 0.8 * dims.z)
-    box.scale = (0.3 * dims.x, 0.4 * dims.y, 0.38 * dims.z)
-    box.rotation_euler = (0.0, math.radians(-10), math.radians(8))
+    box.location = (-0.03 * dims.x, -0.45 * dims.y, 0.72 * dims.z)
+    box.scale = (0.2 * dims.x, 0.45 * dims.y, 0.35 * dims.z)
+    box.rotation_euler = (math.radians(-8), 0.0, math.radians(10))
     piece = cow.copy()
     piece.data = cow.data.copy()
     piece.name = piece.data.name = "Cow piece"
@@ -127,17 +128,27 @@ def run_solid(cow_path, exemplar_path, out_dir, size=64, samples=16):
     if result != {'FINISHED'}:
         raise RuntimeError(f"exsynth.solid_rebake returned {result}")
     t3 = time.perf_counter()
-    # Lift the piece off (the texture is baked: it moves with it).
-    piece.location += Vector((0.1 * dims.x, -0.9 * dims.y, 0.25 * dims.z))
+    # Take the piece out and turn its cut face to the camera, as a block
+    # split open (the texture is baked: it moves with the piece).
+    piece.rotation_euler.z += math.pi
+    view_layer.update()
+    p_lo, p_hi = _world_bounds(piece)
+    target = Vector((0.42 * dims.x, -1.5 * dims.y, 0.0))
+    piece.location += target - Vector((0.5 * (p_lo[0] + p_hi[0]), 0.5 * (p_lo[1] + p_hi[1]), p_lo[2]))
 
     _stage(scene, samples)
-    centre = Vector((0.0, 0.0, 0.45 * dims.z))
-    _aim_camera(scene, centre, distance=4.6, side=0.45)
+    centre = Vector((0.18 * dims.x, -0.6 * dims.y, 0.4 * dims.z))
+    _aim_camera(scene, centre, distance=4.6, side=0.3)
     _render(scene, os.path.join(out_dir, "solid_texture.png"))
     t4 = time.perf_counter()
     print(f"demo: solid {size}³ from {os.path.basename(exemplar_path)} and bake in {t2 - t1:.2f} s, "
           f"re-bake {t3 - t2:.2f} s; render {t4 - t3:.1f} s; total {t4 - t0:.1f} s -> {out_dir}")
     return 0
+
+
+def _world_bounds(obj):
+    corners = (np.array(obj.matrix_world) @ np.c_[np.array(obj.bound_box), np.ones(8)].T)[:3]
+    return corners.min(axis=1), corners.max(axis=1)
 
 
 def _box():

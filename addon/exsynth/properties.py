@@ -105,6 +105,13 @@ class ExSynthSettings(bpy.types.PropertyGroup):
         description="Width and height of each baked image, in pixels",
         default=1024, min=16, max=16384, soft_max=8192,
     )
+    solid_new_uvs: BoolProperty(
+        name="New UV Map",
+        description="Unwrap with Smart UV Project into a UV map 'SolidUV' even when the mesh has "
+        "UV maps (e.g. after a Boolean cut, whose new faces have no useful UVs); a mesh without "
+        "any always gets one, 'UVMap'",
+        default=False,
+    )
     solid_volume: PointerProperty(
         name="Solid",
         description="The solid to bake from: a Volume object made by Solid Texture (its .vdb and "

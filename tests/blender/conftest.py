@@ -1,6 +1,7 @@
 # SPDX-License-Identifier: GPL-3.0-or-later
 """Shared fixtures of the add-on tests (run inside Blender by run_tests.py)."""
 
+import os
 import shutil
 
 import bpy
@@ -8,7 +9,7 @@ import pytest
 
 from exsynth import jobs
 from exsynth.io import volume as volume_io
-from helpers import BUNNY_OBJ
+from helpers import BUNNY_OBJ, COW_OBJ, TEXTURES
 
 
 @pytest.fixture(autouse=True)
@@ -41,3 +42,30 @@ def bunny():
     bpy.context.view_layer.update()
     return obj
 
+
+
+@pytest.fixture
+def cow():
+    """The bundled cow (no UV map), moved and scaled, the only selected object."""
+    bpy.ops.wm.obj_import(filepath=COW_OBJ)
+    obj = bpy.context.view_layer.objects.active
+    assert obj is not None and obj.name == "cow" and len(obj.data.uv_layers) == 0
+    obj.location = (1.5, -0.7, 0.4)
+    obj.scale = (0.8, 0.8, 0.8)
+    bpy.context.view_layer.update()
+    assert [o.name for o in bpy.context.selected_objects] == ["cow"]
+    return obj
+
+
+@pytest.fixture
+def exemplar():
+    """A bundled 128² 8-bit texture, loaded by Blender and set as the Solid
+    Texture exemplar, with settings small enough for fast tests."""
+    image = bpy.data.images.load(os.path.join(TEXTURES, "crackedground.png"))
+    settings = bpy.context.scene.exsynth
+    settings.solid_exemplar = image
+    settings.solid_size = 16
+    settings.solid_levels = 2
+    settings.solid_iterations = 2
+    settings.solid_bake_resolution = 128
+    return image

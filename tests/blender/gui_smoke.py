@@ -1,7 +1,8 @@
 # SPDX-License-Identifier: GPL-3.0-or-later
 """Smoke test of the modal (UI) path, which `blender -b` cannot exercise:
 invoke from a 3D viewport, watch progress, finish; invoke again, press Esc
-mid-run, check the scene is unchanged. Needs a display, e.g. (xvfb package):
+mid-run, check the scene is unchanged; then open the sidebar's ExSynth tab
+(the Solid Texture panels must draw) and run Solid Texture modally. Needs a display, e.g. (xvfb package):
 
     EXSYNTH_ADDON_DIR=build/addon xvfb-run -a -s "-screen 0 1280x800x24" \
         blender --factory-startup --enable-event-simulate --python tests/blender/gui_smoke.py
@@ -36,12 +37,12 @@ def names():
     return sorted(o.name for o in bpy.data.objects)
 
 
-def invoke_in_viewport():
+def invoke_in_viewport(operator="voxelize"):
     win = bpy.context.window_manager.windows[0]
     area = next(a for a in win.screen.areas if a.type == 'VIEW_3D')
     region = next(r for r in area.regions if r.type == 'WINDOW')
     with bpy.context.temp_override(window=win, screen=win.screen, area=area, region=region):
-        return bpy.ops.exsynth.voxelize('INVOKE_DEFAULT')
+        return getattr(bpy.ops.exsynth, operator)('INVOKE_DEFAULT')
 
 
 def check(ok, what):
@@ -97,9 +98,76 @@ def after_esc():
         return 0.1
     check(state["ctx"].cancelled, "Esc cancels the job")
     check(names() == state["before"], "a cancelled run leaves the objects unchanged")
+    state.update(step="solid_start")
+    return 0.1
+
+
+# ---- Solid Texture: its panels draw, its modal run finishes -------------------
+drawn = set()
+
+
+def _record_draws(panel_class):
+    draw = panel_class.draw
+
+    def recording(self, context):
+        draw(self, context)  # an exception propagates: Blender prints it, the flag stays unset
+        drawn.add(panel_class.__name__)
+
+    panel_class.draw = recording
+
+
+def solid_start():
+    bpy.data.batch_remove(list(bpy.data.objects))
+    bpy.ops.wm.obj_import(filepath=os.path.join(ROOT, "assets", "meshes", "cow.obj"))
+    settings = bpy.context.scene.exsynth
+    texture = os.path.join(ROOT, "assets", "textures", "crackedground.png")
+    settings.solid_exemplar = bpy.data.images.load(texture)
+    settings.solid_size, settings.solid_levels, settings.solid_bake_resolution = 32, 2, 256
+    for name in ("EXSYNTH_PT_solid", "EXSYNTH_PT_solid_rebake"):
+        _record_draws(getattr(bpy.types, name))
+    # Open the sidebar and step through its tabs (Ctrl+Wheel) to ExSynth.
+    win = bpy.context.window_manager.windows[0]
+    area = next(a for a in win.screen.areas if a.type == 'VIEW_3D')
+    area.spaces.active.show_region_ui = True
+    area.tag_redraw()
+    # The start-up splash (still open) takes the mouse events: Esc closes it.
+    win.event_simulate('ESC', 'PRESS')
+    win.event_simulate('ESC', 'RELEASE')
+    state.update(step="find_tab", tabs=0)
+    return 0.3
+
+
+def find_tab():
+    if "EXSYNTH_PT_solid" in drawn:
+        check("EXSYNTH_PT_solid_rebake" in drawn, "the Solid Texture panels draw without errors")
+        check(invoke_in_viewport("solid_texture") == {'RUNNING_MODAL'}, "Solid Texture runs modal")
+        state.update(step="solid_finish", t0=time.monotonic())
+        return 0.05
+    if state["tabs"] >= 8:
+        check(False, "the ExSynth sidebar tab draws the Solid Texture panel")
+    win = bpy.context.window_manager.windows[0]
+    area = next(a for a in win.screen.areas if a.type == 'VIEW_3D')
+    region = next(r for r in area.regions if r.type == 'UI')
+    x, y = region.x + region.width - 8, region.y + region.height - 60
+    win.event_simulate('MOUSEMOVE', 'NOTHING', x=x, y=y)
+    win.event_simulate('WHEELDOWNMOUSE', 'PRESS', x=x, y=y, ctrl=True)
+    area.tag_redraw()
+    state["tabs"] += 1
+    return 0.3
+
+
+def solid_finish():
+    if "cow_solid" not in bpy.data.images:
+        if time.monotonic() - state["t0"] > 60:
+            check(False, "Solid Texture finishes within a minute")
+        return 0.05
+    cow = bpy.data.objects["cow"]
+    check(cow.material_slots[0].material.name == "cow_solid" and len(cow.data.uv_layers) == 1,
+          "Solid Texture bakes an image onto the cow and gives it the material")
     print("gui_smoke: all passed", flush=True)
     os._exit(0)
 
 
-STEPS = {"start": start, "wait_finish": wait_finish, "press_esc": press_esc, "after_esc": after_esc}
+STEPS = {"start": start, "wait_finish": wait_finish, "press_esc": press_esc, "after_esc": after_esc,
+         "solid_start": solid_start, "find_tab": find_tab, "solid_finish": solid_finish}
 bpy.app.timers.register(step, first_interval=1.0)

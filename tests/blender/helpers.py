@@ -10,6 +10,8 @@ from exsynth.io import volume as volume_io
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 BUNNY_OBJ = os.path.join(ROOT, "assets", "meshes", "bunny.obj")
+COW_OBJ = os.path.join(ROOT, "assets", "meshes", "cow.obj")
+TEXTURES = os.path.join(ROOT, "assets", "textures")
 
 
 def scene_state():
@@ -25,6 +27,17 @@ def scene_state():
         "selected": sorted(o.name for o in bpy.context.view_layer.objects.selected),
         "active": getattr(bpy.context.view_layer.objects.active, "name", None),
         "cache_files": sorted(os.listdir(cache)) if os.path.isdir(cache) else None,
+    }
+
+
+def mesh_state(obj):
+    """What a failed or cancelled bake must leave untouched on a mesh object."""
+    mesh = obj.data
+    return {
+        "uv_maps": [uv.name for uv in mesh.uv_layers],
+        "attributes": sorted(a.name for a in mesh.attributes),
+        "slots": [(s.link, getattr(s.material, "name", None)) for s in obj.material_slots],
+        "loops": len(mesh.loops),
     }
 
 

@@ -16,7 +16,8 @@ from ..jobs import InputError
 
 IMAGE, ATTRIBUTE = 'IMAGE', 'ATTRIBUTE'
 ATTRIBUTE_NAME = "solid"
-NEW_UV_MAP = "UVMap"
+NEW_UV_MAP = "UVMap"  # made for a mesh without any
+SOLID_UV_MAP = "SolidUV"  # made (or remade) on request beside the mesh's own
 # Smart UV Project as Blender's own default, with a margin so that texels
 # baked around one island do not bleed into the next.
 SMART_UV = {"angle_limit": 1.15192, "island_margin": 0.02}
@@ -61,13 +62,19 @@ def world_bounds(objects):
     return corners.min(axis=0), corners.max(axis=0)
 
 
-def collect(context, objects, mode, world_to_grid):
-    """A BakeTarget per object. A mesh without a UV map (image mode) is
-    unwrapped with Smart UV Project on a temporary copy: the mesh itself is
-    only given the UV map by apply_uvs() once the job has succeeded."""
+def collect(context, objects, mode, world_to_grid, new_uvs=False):
+    """A BakeTarget per object. A mesh without a UV map (image mode), or
+    every mesh with `new_uvs`, is unwrapped with Smart UV Project on a
+    temporary copy: the mesh itself is only given the UV map by apply_uvs()
+    once the job has succeeded."""
     targets = []
     for obj in objects:
         mesh = obj.data
+        if obj.library is not None or mesh.library is not None:
+            raise InputError(
+                f"the mesh '{obj.name}' is linked from another file, so it cannot get a new material "
+                "or UV map. Make it local (Object > Relations > Make Local) or deselect it"
+            )
         if len(mesh.polygons) == 0:
             raise InputError(
                 f"the mesh '{obj.name}' has no faces (only vertices or edges), so there is no "
@@ -75,7 +82,7 @@ def collect(context, objects, mode, world_to_grid):
             )
         if mode == ATTRIBUTE:
             targets.append(_attribute_target(obj, world_to_grid))
-        elif mesh.uv_layers.active is not None:
+        elif mesh.uv_layers.active is not None and not new_uvs:
             depsgraph = context.evaluated_depsgraph_get()
             target = _image_target(obj, obj, depsgraph, mesh.uv_layers.active.name, world_to_grid)
             targets.append(target)
@@ -144,6 +151,12 @@ def _image_target(obj, source, depsgraph, uv_map, world_to_grid):
 def _unwrapped_target(context, obj, world_to_grid):
     """Smart UV Project on a temporary copy of the object (its modifiers
     included); the copy is gone, and selection restored, before this returns."""
+    uv_map = SOLID_UV_MAP if len(obj.data.uv_layers) else NEW_UV_MAP
+    if obj.data.uv_layers.get(uv_map) is None and len(obj.data.uv_layers) >= 8:
+        raise InputError(
+            f"the mesh '{obj.name}' has 8 UV maps, the most Blender allows, so there is no room for "
+            f"'{uv_map}'. Remove one (Properties > Object Data > UV Maps) and run again"
+        )
     view_layer = context.view_layer
     selected = list(context.selected_objects)
     active = view_layer.objects.active
@@ -151,6 +164,8 @@ def _unwrapped_target(context, obj, world_to_grid):
     temp.data = obj.data.copy()
     temp_ids = [temp, temp.data]
     try:
+        uv_layers = temp.data.uv_layers
+        uv_layers.active = uv_layers.get(uv_map) or uv_layers.new(name=uv_map)
         context.scene.collection.objects.link(temp)
         for other in selected:
             other.select_set(False)
@@ -172,7 +187,7 @@ def _unwrapped_target(context, obj, world_to_grid):
         for other in selected:
             other.select_set(True)
         view_layer.objects.active = active
-    target.uv_map = NEW_UV_MAP
+    target.uv_map = uv_map
     target.new_uvs = new_uvs.reshape(-1, 2)
     return target
 
@@ -194,13 +209,21 @@ def target_object(target):
 
 
 def apply_uvs(obj, target, created):
-    """Give the mesh the UV map the bake used, if it had none (once per mesh)."""
-    mesh = obj.data
-    if target.new_uvs is None or mesh.uv_layers.get(target.uv_map) is not None:
+    """Give the mesh the UV map the bake made (a new one, or new UVs in the
+    one of that name)."""
+    if target.new_uvs is None:
         return
-    layer = mesh.uv_layers.new(name=target.uv_map)
-    name = layer.name
-    created.add_undo(lambda: mesh.uv_layers.remove(mesh.uv_layers[name]))
+    mesh = obj.data
+    layer = mesh.uv_layers.get(target.uv_map)
+    if layer is None:
+        layer = mesh.uv_layers.new(name=target.uv_map)
+        name = layer.name
+        created.add_undo(lambda: mesh.uv_layers.remove(mesh.uv_layers[name]))
+    else:
+        old = np.empty(2 * len(layer.data), np.float32)
+        layer.data.foreach_get("uv", old)
+        name = layer.name
+        created.add_undo(lambda: mesh.uv_layers[name].data.foreach_set("uv", old))
     layer.data.foreach_set("uv", target.new_uvs.ravel())
 
 

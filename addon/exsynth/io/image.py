@@ -82,13 +82,14 @@ def convert(values, from_encoding, to_encoding):
 
 def srgb_to_linear(v):
     v = np.asarray(v, np.float32)
-    return np.where(v <= 0.04045, v / 12.92, ((np.maximum(v, 0.04045) + 0.055) / 1.055) ** 2.4).astype(np.float32)
+    curve = ((np.maximum(v, 0.04045) + 0.055) / 1.055) ** 2.4
+    return np.where(v <= 0.04045, v / 12.92, curve).astype(np.float32)
 
 
 def linear_to_srgb(v):
     v = np.asarray(v, np.float32)
-    return np.where(v <= 0.0031308, v * 12.92,
-                    1.055 * np.maximum(v, 0.0031308) ** (1 / 2.4) - 0.055).astype(np.float32)
+    curve = 1.055 * np.maximum(v, 0.0031308) ** (1 / 2.4) - 0.055
+    return np.where(v <= 0.0031308, v * 12.92, curve).astype(np.float32)
 
 
 def new_image(name, pixels, encoding, created=None, pack=True):

@@ -59,11 +59,13 @@ def solid_volume_material(name, srgb, density, created):
 
     `srgb`: the grid holds display-encoded colours (from an 8-bit exemplar),
     turned back to linear for rendering with a gamma of 2.2. `density` is per
-    unit length, so that a tile of the solid renders as a dense block."""
+    unit length, so that a tile of the solid renders as a dense block. The
+    colour both scatters and glows (emission = density: in a dense block the
+    glow shows the colour as it is), so dark exemplars stay readable."""
     mat = created.add(bpy.data.materials.new(name))
     shader = _output_with(mat, "ShaderNodeVolumePrincipled", "Volume")
     shader.inputs["Density"].default_value = density
-    shader.inputs["Density Attribute"].default_value = ""  # no density grid: uniform
+    shader.inputs["Density Attribute"].default_value = "density"  # 1 inside the tile
     tree = mat.node_tree
     attr = tree.nodes.new("ShaderNodeAttribute")
     attr.attribute_name = "color"
@@ -76,6 +78,8 @@ def solid_volume_material(name, srgb, density, created):
         tree.links.new(colour, gamma.inputs["Color"])
         colour = gamma.outputs["Color"]
     tree.links.new(colour, shader.inputs["Color"])
+    tree.links.new(colour, shader.inputs["Emission Color"])
+    shader.inputs["Emission Strength"].default_value = density
     return mat
 
 

@@ -86,10 +86,15 @@ class Solid:
         return np.full(3, 0.5 * self.voxel_size)
 
 
-def solid_grids(values):
+def solid_grids(values, density=False):
     """Volume grids of a solid: "color" (the first three channels), then
-    "alpha" (a 4th) or "channel_<i>" (any further) as float grids."""
+    "alpha" (a 4th) or "channel_<i>" (any further) as float grids; with
+    `density` also "density", 1 over the tile, so that a render shows the
+    tile as a block (a constant density would also fill the empty margin
+    Blender puts around a volume's voxels)."""
     grids = {"color": np.ascontiguousarray(values[..., :3])}
+    if density:
+        grids["density"] = np.ones(values.shape[:3], np.float32)
     channels = values.shape[3]
     for c in range(3, channels):
         grids["alpha" if channels == 4 else f"channel_{c}"] = np.ascontiguousarray(values[..., c])
@@ -283,7 +288,8 @@ def add_solid_volume(context, result, created):
     from it), with a material that shows its colours when unhidden."""
     solid, name = result.solid, result.name + SUFFIX
     path = volume_io.new_cache_path(name)
-    volume_io.write_vdb(path, solid_grids(solid.values), solid.origin, solid.voxel_size, created)
+    volume_io.write_vdb(path, solid_grids(solid.values, density=True), solid.origin, solid.voxel_size,
+                        created)
     obj = volume_io.new_volume_object(name, path, solid.voxel_size, context.collection, created)
     obj.location = result.anchor - volume_io.blender_cell_offset(solid.voxel_size)
     scale = solid.voxel_size * solid.size
@@ -319,7 +325,8 @@ class EXSYNTH_OT_solid_texture(JobOperator, bpy.types.Operator):
         )
         objects = bake_io.mesh_objects(context, self.bl_label)
         anchor, _ = bake_io.world_bounds(objects)
-        targets = bake_io.collect(context, objects, settings.solid_bake_target, translation(-anchor))
+        targets = bake_io.collect(context, objects, settings.solid_bake_target, translation(-anchor),
+                                  new_uvs=settings.solid_new_uvs)
         return SolidJob(
             name=exemplar_name(settings.solid_exemplar), exemplar=exemplar,
             exemplar_y=exemplar_y, exemplar_z=exemplar_z, size=settings.solid_size,
@@ -370,10 +377,16 @@ class EXSYNTH_OT_solid_rebake(JobOperator, bpy.types.Operator):
             )
         meta = volume.get(METADATA, {})
         size = int(meta.get("size", 0))
-        voxel_size = float(meta["scale"]) / size if size else volume.grids["color"].matrix_object[0][0]
-        objects = [o for o in bake_io.mesh_objects(context, self.bl_label)]
+        if size:
+            voxel_size = float(meta["scale"]) / size
+        else:  # a .vdb from elsewhere: its box is the tile, its grid transform the voxel size
+            grid = volume.grids["color"]
+            grid.load()
+            voxel_size = abs(grid.matrix_object[0][0])
+        objects = bake_io.mesh_objects(context, self.bl_label)
         targets = bake_io.collect(
-            context, objects, settings.solid_bake_target, world_to_grid(volume_obj, voxel_size)
+            context, objects, settings.solid_bake_target, world_to_grid(volume_obj, voxel_size),
+            new_uvs=settings.solid_new_uvs,
         )
         return RebakeJob(
             name=volume_obj.name, path=path, size=size,

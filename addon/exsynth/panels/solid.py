@@ -42,6 +42,7 @@ class EXSYNTH_PT_solid(_Panel, bpy.types.Panel):
         col.prop(settings, "solid_bake_target")
         if settings.solid_bake_target == 'IMAGE':
             col.prop(settings, "solid_bake_resolution")
+            col.prop(settings, "solid_new_uvs")
 
         meshes = [o for o in context.selected_objects if o.type == 'MESH']
         box = layout.box()
