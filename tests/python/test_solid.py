@@ -181,3 +181,17 @@ def test_bake_margin_grows_islands_and_rejects_bad_input():
         _native.bake_volume_to_uv(vol, [0, 0, 0], 1.0, pos[:0], uv[:0], 8, 8)
     with pytest.raises(_native.InvalidInputError, match="16384"):
         _native.bake_volume_to_uv(vol, [0, 0, 0], 1.0, pos, uv, 0, 8)
+
+
+def test_bake_gives_sub_texel_islands_their_centroid_texel():
+    rng = np.random.default_rng(7)
+    vol = rng.random((4, 4, 4, 1), dtype=np.float32)
+    # A UV triangle far smaller than a texel, between texel centres.
+    pos = np.array([[[0.5, 0.5, 0.5], [1.5, 0.5, 0.5], [0.5, 1.5, 0.5]]], np.float32)
+    uv = np.array([[[0.26, 0.26], [0.27, 0.26], [0.26, 0.27]]], np.float32)  # 8x8 texels: centres at 1/16 + k/8
+    img, mask = _native.bake_volume_to_uv(vol, [0, 0, 0], 1.0, pos, uv, 8, 8, margin=0)
+    assert (mask == 1).sum() == 1
+    y, x = np.argwhere(mask == 1)[0]
+    assert (x, y) == (int(round(0.2633 * 8 - 0.5)), int(round(0.2633 * 8 - 0.5)))
+    want = _native.sample_volume(vol, [0, 0, 0], 1.0, pos[0].mean(0, keepdims=True))[0]
+    np.testing.assert_allclose(img[y, x], want, atol=1e-6)

@@ -22,6 +22,31 @@ void sample_at(const Volume& vol, const Eigen::Vector3f& p, Boundary b, float* o
 
 constexpr int kBand = 16;  // image rows per parallel task; a task owns its rows
 
+float edge_function(const Eigen::Vector2f& a, const Eigen::Vector2f& b, const Eigen::Vector2f& p) {
+  return (b - a).x() * (p - a).y() - (b - a).y() * (p - a).x();
+}
+
+// Whether a triangle (in texel-centre coordinates) contains any texel
+// centre, anywhere in the image plane. Exact for triangles whose bounding
+// box holds at most 16 lattice points; larger ones are taken to cover one.
+bool covers_a_texel_centre(const Eigen::Vector2f t[3]) {
+  const int x0 = int(std::ceil(std::min({t[0].x(), t[1].x(), t[2].x()})));
+  const int x1 = int(std::floor(std::max({t[0].x(), t[1].x(), t[2].x()})));
+  const int y0 = int(std::ceil(std::min({t[0].y(), t[1].y(), t[2].y()})));
+  const int y1 = int(std::floor(std::max({t[0].y(), t[1].y(), t[2].y()})));
+  if (x1 < x0 || y1 < y0) return false;
+  if (std::int64_t(x1 - x0 + 1) * (y1 - y0 + 1) > 16) return true;
+  const float area = edge_function(t[0], t[1], t[2]);
+  for (int y = y0; y <= y1; ++y)
+    for (int x = x0; x <= x1; ++x) {
+      const Eigen::Vector2f p{float(x), float(y)};
+      const float w0 = edge_function(t[1], t[2], p) / area, w1 = edge_function(t[2], t[0], p) / area,
+                  w2 = edge_function(t[0], t[1], p) / area;
+      if (w0 >= -1e-6f && w1 >= -1e-6f && w2 >= -1e-6f) return true;
+    }
+  return false;
+}
+
 }  // namespace
 
 void sample_volume(const Volume& vol, const std::vector<Eigen::Vector3f>& points, bool wrap, float* out,
@@ -81,28 +106,43 @@ BakeResult bake_volume_to_uv(const Volume& vol, const std::vector<std::array<Eig
         // Texel (x, y)'s centre is at uv ((x + 0.5) / W, (y + 0.5) / H).
         Eigen::Vector2f t[3];
         for (int k = 0; k < 3; ++k) t[k] = Eigen::Vector2f(uvs[f][k].x() * W - 0.5f, uvs[f][k].y() * H - 0.5f);
-        const float area = (t[1] - t[0]).x() * (t[2] - t[0]).y() - (t[1] - t[0]).y() * (t[2] - t[0]).x();
+        const float area = edge_function(t[0], t[1], t[2]);
         if (std::abs(area) < 1e-12f) continue;  // degenerate in UV space: covers no texel centre
         const int x0 = std::max(0, int(std::ceil(std::min({t[0].x(), t[1].x(), t[2].x()}))));
         const int x1 = std::min(W - 1, int(std::floor(std::max({t[0].x(), t[1].x(), t[2].x()}))));
         const int y0 = std::max(row0, int(std::ceil(std::min({t[0].y(), t[1].y(), t[2].y()}))));
         const int y1 = std::min(row1 - 1, int(std::floor(std::max({t[0].y(), t[1].y(), t[2].y()}))));
         const float eps = -1e-6f;  // texel centres on a shared edge belong to both triangles
+        bool covered_any = false;
         for (int y = y0; y <= y1; ++y)
           for (int x = x0; x <= x1; ++x) {
             const Eigen::Vector2f p{float(x), float(y)};
-            auto edge = [&](const Eigen::Vector2f& a, const Eigen::Vector2f& c) {
-              return ((c - a).x() * (p - a).y() - (c - a).y() * (p - a).x()) / area;
-            };
-            const float w0 = edge(t[1], t[2]), w1 = edge(t[2], t[0]), w2 = edge(t[0], t[1]);
+            const float w0 = edge_function(t[1], t[2], p) / area, w1 = edge_function(t[2], t[0], p) / area,
+                        w2 = edge_function(t[0], t[1], p) / area;
             if (w0 < eps || w1 < eps || w2 < eps) continue;
             const Eigen::Vector3f pos = w0 * positions[f][0] + w1 * positions[f][1] + w2 * positions[f][2];
             sample_at(vol, pos, b, r.image.data() + r.image.offset(x, y));
             r.mask[std::size_t(y) * W + x] = 1;
+            covered_any = true;
           }
+        if (!covered_any && !covers_a_texel_centre(t)) {
+          // A UV island smaller than a texel covers no texel centre: give
+          // the texel under its centroid the centroid's value, unless a
+          // covering triangle already owns that texel.
+          const Eigen::Vector2f c = (t[0] + t[1] + t[2]) / 3.0f;
+          const int x = int(std::lround(c.x())), y = int(std::lround(c.y()));
+          if (x >= 0 && x < W && y >= row0 && y < row1 && r.mask[std::size_t(y) * W + x] != 1) {
+            const Eigen::Vector3f pos = (positions[f][0] + positions[f][1] + positions[f][2]) / 3.0f;
+            sample_at(vol, pos, b, r.image.data() + r.image.offset(x, y));
+            r.mask[std::size_t(y) * W + x] = 3;
+          }
+        }
       }
     }
   });
+
+  for (auto& m : r.mask)
+    if (m == 3) m = 1;  // sub-texel islands count as covered
 
   // Margin: grow islands one texel ring per pass with the mean of the filled
   // 8-neighbours, reading the previous pass only (deterministic).
