@@ -38,7 +38,7 @@ def main(argv=None):
     args = ap.parse_args(argv)
     exe = os.path.join(args.build, "exsynth_bench")
     print(f"machine: {os.cpu_count()} cores; median of {args.repetitions} runs; one process per row")
-    header = f"{'benchmark':<44} {'median':>10} {'min':>10} {'peak RSS':>10}  counters"
+    header = f"{'benchmark':<56} {'median':>10} {'min':>10} {'peak RSS':>10}  counters"
     print(header)
     print("-" * len(header))
     for name in list_benchmarks(exe, args.filter):
@@ -51,7 +51,7 @@ def main(argv=None):
                 "real_time", "cpu_time", "time_unit", "aggregate_name", "aggregate_unit", "family_index",
                 "per_family_instance_index"}
         counters = ", ".join(f"{k}={v:.4g}" for k, v in med.items() if k not in skip and isinstance(v, (int, float)))
-        print(f"{name:<44} {med['real_time']:>8.1f}{unit:>2} {times[0]:>8.1f}{unit:>2} "
+        print(f"{name:<56} {med['real_time']:>8.1f}{unit:>2} {times[0]:>8.1f}{unit:>2} "
               f"{rss:>7.0f}MiB  {counters}")
     return 0
 
