@@ -2,6 +2,8 @@
 """Helpers shared by the add-on tests (plain functions; fixtures are in conftest.py)."""
 
 import os
+import threading
+import time
 
 import bpy
 import numpy as np
@@ -83,3 +85,21 @@ def volume_surface_points(volume_obj, grid_name, threshold):
 def bbox(points):
     points = np.asarray(points)
     return points.min(axis=0), points.max(axis=0)
+
+
+def cancel_once_running(seen):
+    """A jobs.job_started_hooks entry that cancels the job from another
+    thread as soon as it reports progress, as Esc does mid-run; it records
+    the progress and stage it saw in `seen`."""
+
+    def hook(ctx):
+        def watch():
+            deadline = time.monotonic() + 30
+            while ctx.progress == 0.0 and time.monotonic() < deadline:
+                time.sleep(0.001)
+            seen["progress"], seen["stage"] = ctx.progress, ctx.stage
+            ctx.cancel()
+
+        threading.Thread(target=watch, daemon=True).start()
+
+    return hook

@@ -1,7 +1,6 @@
 # SPDX-License-Identifier: GPL-3.0-or-later
 """Cancelled or failed runs leave the scene (and the cache folder) exactly as it was."""
 
-import threading
 import time
 
 import bpy
@@ -10,7 +9,7 @@ import pytest
 from exsynth import _native, jobs
 from exsynth.io import materials
 from exsynth.operators.voxelize import VoxelizeJob
-from helpers import scene_state, world_mesh
+from helpers import cancel_once_running, scene_state, world_mesh
 
 
 def test_cancel_before_the_engine_starts(bunny):
@@ -23,18 +22,7 @@ def test_cancel_before_the_engine_starts(bunny):
 
 def test_cancel_while_the_engine_runs(bunny):
     seen = {}
-
-    def cancel_once_running(ctx):
-        def watch():
-            deadline = time.monotonic() + 30
-            while ctx.progress == 0.0 and time.monotonic() < deadline:
-                time.sleep(0.001)
-            seen["progress"], seen["stage"] = ctx.progress, ctx.stage
-            ctx.cancel()
-
-        threading.Thread(target=watch, daemon=True).start()
-
-    jobs.job_started_hooks.append(cancel_once_running)
+    jobs.job_started_hooks.append(cancel_once_running(seen))
     bpy.context.scene.exsynth.resolution = 320  # seconds of work: time to cancel mid-way
     before = scene_state()
     t0 = time.perf_counter()

@@ -4,7 +4,6 @@ results, placement, consistency between bakes, exemplar reading, errors,
 cancel and rollback. Small solids (16³, 2 levels) keep it fast."""
 
 import os
-import threading
 import time
 
 import bpy
@@ -16,7 +15,7 @@ from exsynth.io import bake as bake_io
 from exsynth.io import image as image_io
 from exsynth.io import volume as volume_io
 from exsynth.operators import solid as solid_ops
-from helpers import TEXTURES, mesh_state, scene_state
+from helpers import TEXTURES, cancel_once_running, mesh_state, scene_state
 
 
 def settings():
@@ -464,18 +463,7 @@ def test_cancel_before_the_engine_starts(cow, exemplar):
 
 def test_cancel_while_the_engine_runs(cow, exemplar):
     seen = {}
-
-    def cancel_once_running(ctx):
-        def watch():
-            deadline = time.monotonic() + 30
-            while ctx.progress == 0.0 and time.monotonic() < deadline:
-                time.sleep(0.001)
-            seen["progress"] = ctx.progress
-            ctx.cancel()
-
-        threading.Thread(target=watch, daemon=True).start()
-
-    jobs.job_started_hooks.append(cancel_once_running)
+    jobs.job_started_hooks.append(cancel_once_running(seen))
     s = settings()
     s.solid_size, s.solid_levels = 96, 3  # seconds of work
     before, mesh_before = scene_state(), mesh_state(cow)
