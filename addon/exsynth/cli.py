@@ -17,6 +17,7 @@ from . import _native, jobs
 from .io import bake as bake_io
 from .io import image as image_io
 from .io import mesh as mesh_io
+from .operators import field as field_ops
 from .operators import solid as solid_ops
 from .operators.voxelize import VoxelizeJob
 from .properties import GIB
@@ -116,6 +117,22 @@ def _parser():
     p.add_argument("--memory-budget", type=float, default=0.0,
                    help="refuse jobs needing more than this many GiB (default: the engine's 8 GiB)")
     p.set_defaults(run=_run_image)
+
+    p = sub.add_parser(
+        "field", help="mesh -> direction field (.npy, one unit tangent per vertex)",
+        description="A direction field on a mesh, as the Direction Field operator makes it: from a "
+        "preset, or by diffusing painted vectors (zero = free) over the surface. Written as a "
+        "(V, 3) float32 .npy in the file's vertex order and coordinates (no axis conversion).",
+    )
+    p.add_argument("--mesh", required=True, help="input mesh: .obj or .ply")
+    how = p.add_mutually_exclusive_group(required=True)
+    how.add_argument("--preset", choices=("around_axis", "along_axis", "along_curve"),
+                     help="a field from a rule (along_curve needs --curve)")
+    how.add_argument("--paint", help="(V, 3) .npy of painted vectors in the file's vertex order; zero = free")
+    p.add_argument("--axis", choices=("x", "y", "z"), default="z", help="the presets' axis (default z)")
+    p.add_argument("--curve", help="along_curve: (N, 3) .npy polyline in the mesh's coordinates, N >= 2")
+    p.add_argument("--out", required=True, help="the field: (V, 3) float32 .npy")
+    p.set_defaults(run=_run_field)
 
     p = sub.add_parser("demo", help="voxelize the bundled bunny, solid-texture the cow; render PNGs",
                        description="Voxelize assets/meshes/bunny.obj, solid-texture assets/meshes/cow.obj "
@@ -314,6 +331,45 @@ def _enable_bundled_addon(name):
     loaded_default, loaded_state = addon_utils.check(name)
     if not loaded_state and addon_utils.enable(name, default_set=False) is None:
         raise RuntimeError(f"Blender's bundled add-on {name} could not be enabled")
+
+
+# ---- field ---------------------------------------------------------------------
+def _run_field(args):
+    mesh_path = _input_file("--mesh", args.mesh, (".obj", ".ply"))
+    _extension("--out", args.out, (".npy",))
+    _require(args.preset != "along_curve" or args.curve, "--preset along_curve needs --curve CURVE.npy")
+    _require(not args.curve or args.preset == "along_curve", "--curve goes with --preset along_curve")
+    paint = _load_npy("--paint", args.paint) if args.paint else None
+    curve = _load_npy("--curve", args.curve) if args.curve else None
+
+    objects = import_mesh(mesh_path)
+    _require(len(objects) == 1, f"--mesh: {mesh_path} holds {len(objects)} meshes; the field needs exactly one")
+    verts, tris = mesh_io.mesh_arrays(objects[0].data)
+    if len(tris) == 0:
+        raise UsageError(f"--mesh: {mesh_path} has no faces to put a field on")
+    if paint is not None:
+        _require(paint.shape == verts.shape,
+                 f"--paint: {args.paint} is {paint.shape}, the mesh needs ({len(verts)}, 3): one vector per vertex")
+    job = field_ops.FieldJob(
+        vertices=verts, triangles=tris, preset=args.preset or "around_axis",
+        axis=field_ops.AXES[args.axis.upper()], curve=curve, given=paint,
+    )
+    runner = jobs.Runner(job)
+    runner.run_here()
+    field = runner.outcome()
+    _make_parent(args.out)
+    np.save(args.out, np.ascontiguousarray(field, np.float32))
+    how = f"diffused from {os.path.basename(args.paint)}" if paint is not None else args.preset
+    print(f"field: {len(field)} vertices, {how}, in {runner.seconds:.2f} s -> {args.out}")
+    return 0
+
+
+def _load_npy(arg, path):
+    path = _input_file(arg, path, (".npy",))
+    try:
+        return np.load(path, allow_pickle=False)
+    except ValueError as exc:
+        raise UsageError(f"{arg}: {path} is not a numeric .npy array ({exc})")
 
 
 # ---- demo --------------------------------------------------------------------

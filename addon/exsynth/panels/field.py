@@ -1,0 +1,51 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
+"""Direction Field in the "ExSynth" sidebar tab."""
+
+import bpy
+
+from .main import CATEGORY
+
+
+class EXSYNTH_PT_field(bpy.types.Panel):
+    bl_label = "Direction Field"
+    bl_space_type = 'VIEW_3D'
+    bl_region_type = 'UI'
+    bl_category = CATEGORY
+    bl_options = {'DEFAULT_CLOSED'}
+
+    def draw(self, context):
+        layout = self.layout
+        layout.use_property_split = True
+        layout.use_property_decorate = False
+        settings = context.scene.exsynth
+        obj = context.active_object
+        mesh = obj.data if obj is not None and obj.type == 'MESH' else None
+
+        col = layout.column()
+        col.prop(settings, "field_mode")
+        if settings.field_mode == 'PRESET':
+            col.prop(settings, "field_preset")
+            if settings.field_preset == 'ALONG_CURVE':
+                col.prop(settings, "field_curve")
+            else:
+                col.row().prop(settings, "field_axis", expand=True)
+        elif mesh is not None:
+            col.prop_search(settings, "field_paint_attribute", mesh, "attributes")
+        else:
+            col.prop(settings, "field_paint_attribute")
+
+        box = layout.box()
+        if mesh is None:
+            box.label(text="Select a mesh object", icon='INFO')
+        else:
+            box.label(text=f"{obj.name}: {len(mesh.vertices)} vertices", icon='MESH_DATA')
+            if settings.field_mode == 'DIFFUSE' and mesh.attributes.get(settings.field_paint_attribute) is None:
+                box.label(text="Add a Vector (Vertex) attribute to paint", icon='ERROR')
+            if mesh.attributes.get("exsynth_field") is not None:
+                box.label(text="Replaces its 'exsynth_field'", icon='INFO')
+        row = layout.row()
+        row.scale_y = 1.4
+        row.operator("exsynth.direction_field", icon='ORIENTATION_NORMAL')
+
+
+CLASSES = (EXSYNTH_PT_field,)
