@@ -13,10 +13,15 @@ Pca fit_pca(const RowMatrixXf& samples, double variance, int max_dims) {
   Pca pca;
   const Eigen::Index n = samples.rows(), D = samples.cols();
   pca.mean = samples.colwise().mean();
-  // Covariance in double: the eigen-decomposition of a near-singular float
-  // covariance loses the small components' order.
-  const Eigen::MatrixXd centred = (samples.rowwise() - pca.mean).cast<double>();
-  const Eigen::MatrixXd cov = (centred.transpose() * centred) / double(std::max<Eigen::Index>(1, n - 1));
+  // Covariance in double (the eigen-decomposition of a near-singular float
+  // covariance loses the small components' order) from at most kMaxRows
+  // evenly strided rows: the leading components of a few thousand
+  // neighbourhoods are those of all of them, at a fraction of the cost.
+  constexpr Eigen::Index kMaxRows = 4096;
+  const Eigen::Index step = (n + kMaxRows - 1) / kMaxRows, rows = (n + step - 1) / step;
+  Eigen::MatrixXd centred(rows, D);
+  for (Eigen::Index r = 0; r < rows; ++r) centred.row(r) = (samples.row(r * step) - pca.mean).cast<double>();
+  const Eigen::MatrixXd cov = (centred.transpose() * centred) / double(std::max<Eigen::Index>(1, rows - 1));
   Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(cov);
   const Eigen::VectorXd values = eig.eigenvalues().reverse().cwiseMax(0.0);  // decreasing
   const double total = values.sum();

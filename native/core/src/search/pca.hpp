@@ -20,7 +20,7 @@ struct Pca {
 
 /// Fits on the rows of `samples` (n x D): keeps the fewest leading components
 /// whose variance reaches `variance` of the total, at most `max_dims`, at
-/// least 1. Deterministic (no random subsampling).
+/// least 1. Deterministic: large sample sets are strided, not randomly subsampled.
 Pca fit_pca(const RowMatrixXf& samples, double variance, int max_dims);
 
 }  // namespace exsynth::search
