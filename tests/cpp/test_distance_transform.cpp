@@ -17,12 +17,12 @@ TEST(DistanceTransform, OneDimensionalMatchesBruteForce) {
     std::vector<float> f(n, kFarAway), d(n);
     std::vector<std::int32_t> lab(n), out(n);
     std::vector<int> v(n);
-    std::vector<double> z(n + 1);
+    std::vector<double> g(n), z(n + 1);
     for (int i = 0; i < n; ++i) {
       lab[i] = i;
       if (gen() % 4 == 0) f[i] = float(gen() % 100) / 50.0f;
     }
-    distance_transform_1d(f.data(), lab.data(), n, d.data(), out.data(), v.data(), z.data());
+    distance_transform_1d(f.data(), lab.data(), n, d.data(), out.data(), v.data(), g.data(), z.data());
     for (int q = 0; q < n; ++q) {
       float best = kFarAway;
       for (int p = 0; p < n; ++p)

@@ -19,8 +19,9 @@ constexpr float kFarAway = 1e30f;  ///< "no seed here"
 void distance_transform(int nx, int ny, int nz, std::vector<float>& dist2,
                         std::vector<std::int32_t>& label, StageProgress& progress);
 
-/// 1-D transform (exposed for tests): f and lab in, d and out_lab out; n values.
+/// 1-D transform (exposed for tests): f and lab in, d and out_lab out; n
+/// values. Scratch: v and g hold n entries, z n + 1.
 void distance_transform_1d(const float* f, const std::int32_t* lab, int n, float* d, std::int32_t* out_lab,
-                           int* v_scratch, double* z_scratch);
+                           int* v_scratch, double* g_scratch, double* z_scratch);
 
 }  // namespace exsynth::voxel
