@@ -59,3 +59,26 @@ def test_cancel():
     v = np.zeros((8, 8, 8), np.float32)
     with pytest.raises(_native.CancelledError):
         _native.synthesize_analogy(v, v, v, ctx=ctx)
+
+
+def test_volume_frames_on_the_bunny_follow_its_field(bunny):
+    verts, faces = bunny
+    vox = _native.voxelize(verts, faces, resolution=32)
+    field = _native.preset_direction_field(verts, faces, "around_axis", axis=(0, 1, 0))
+    fr = _native.volume_frames(vox["sdf"], vox["origin"], vox["voxel_size"], verts, field)
+    t, n, b = fr["t"], fr["n"], fr["b"]
+    assert t.shape == vox["sdf"].shape + (3,)
+    np.testing.assert_allclose(np.linalg.norm(t, axis=-1), 1, atol=1e-4)
+    np.testing.assert_allclose((t * n).sum(-1), 0, atol=1e-4)
+    np.testing.assert_allclose(b, np.cross(t, n), atol=1e-4)
+    # Around the y axis: T has (almost) no y component near the surface, away from the axis.
+    near = np.abs(vox["sdf"]) < vox["voxel_size"]
+    assert np.median(np.abs(t[near][:, 1])) < 0.2
+
+
+def test_volume_frames_reject_bad_input():
+    sdf = np.ones((4, 4, 4), np.float32)
+    with pytest.raises(_native.InvalidInputError, match="points"):
+        _native.volume_frames(sdf, [0, 0, 0], 1.0, np.zeros((3, 2)), np.zeros((3, 3)))
+    with pytest.raises(_native.InvalidInputError, match="no voxels within"):
+        _native.volume_frames(sdf * 10, [0, 0, 0], 1.0, np.zeros((3, 3)), np.ones((3, 3)))
