@@ -103,3 +103,15 @@ def cancel_once_running(seen):
         threading.Thread(target=watch, daemon=True).start()
 
     return hook
+
+
+def add_faceless_mesh(name="Dots"):
+    """A mesh object with three vertices and no faces, linked and active:
+    the 'mesh has no faces' bad input every mesh operator must refuse."""
+    mesh = bpy.data.meshes.new(name)
+    mesh.vertices.add(3)
+    mesh.vertices.foreach_set("co", np.eye(3, dtype=np.float32).ravel())
+    obj = bpy.data.objects.new(name, mesh)
+    bpy.context.collection.objects.link(obj)
+    bpy.context.view_layer.objects.active = obj
+    return obj

@@ -4,10 +4,9 @@ scene stays as it was. In background mode bpy.ops raises RuntimeError
 carrying the operator's error report."""
 
 import bpy
-import numpy as np
 import pytest
 
-from helpers import scene_state
+from helpers import add_faceless_mesh, scene_state
 
 
 def run_expecting_error(match):
@@ -30,12 +29,7 @@ def test_active_object_is_not_a_mesh(bunny):
 
 
 def test_mesh_without_faces():
-    mesh = bpy.data.meshes.new("Dots")
-    mesh.vertices.add(3)
-    mesh.vertices.foreach_set("co", np.eye(3, dtype=np.float32).ravel())
-    obj = bpy.data.objects.new("Dots", mesh)
-    bpy.context.collection.objects.link(obj)
-    bpy.context.view_layer.objects.active = obj
+    obj = add_faceless_mesh()
     run_expecting_error(r"'Dots' has no faces")
 
 

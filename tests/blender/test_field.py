@@ -8,7 +8,7 @@ import pytest
 
 from exsynth import _native, cli, jobs
 from exsynth.operators import field as field_ops
-from helpers import BUNNY_OBJ, scene_state
+from helpers import BUNNY_OBJ, add_faceless_mesh, scene_state
 
 FIELD = "exsynth_field"
 
@@ -169,12 +169,7 @@ def test_no_active_mesh(bunny):
 
 
 def test_mesh_without_faces():
-    mesh = bpy.data.meshes.new("Dots")
-    mesh.vertices.add(3)
-    mesh.vertices.foreach_set("co", np.eye(3, dtype=np.float32).ravel())
-    obj = bpy.data.objects.new("Dots", mesh)
-    bpy.context.collection.objects.link(obj)
-    bpy.context.view_layer.objects.active = obj
+    obj = add_faceless_mesh()
     run_expecting_error(r"'Dots' has no faces", obj)
 
 
