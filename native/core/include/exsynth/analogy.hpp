@@ -1,15 +1,26 @@
 #pragma once
 // Volumetric geometric texture by example (Bhat, Ingram & Turk 2004): B' is
-// to B as A' is to A. This first engine is the isotropic variant (the
-// paper's blur and dilation analogies): one global frame, neighbourhoods
-// aligned with the grid axes, voxels visited in scanline order. The
-// field-aligned frames and sweep order of §4 are not implemented yet.
+// to B as A' is to A.
 //
-// Per level, coarse to fine, every voxel q of B' gets A'(p) for the voxel p
-// of A whose feature vector is nearest to q's: [causal fine neighbourhood of
-// B' (voxels already visited), full fine neighbourhood of B, full coarse
-// neighbourhood of B', full coarse neighbourhood of B]; A's are built the
-// same way from A' and A. Nearest neighbours: PCA + nanoflann k-d tree.
+// Per level of Gaussian pyramids, coarse to fine, B' starts as B (coarsest)
+// or as the coarser B' upsampled, and every voxel q near the surface is
+// visited in sweep order and gets A'(p) for the voxel p of A whose feature
+// vector matches q's best: [causal fine neighbourhood of B' (voxels already
+// visited), full fine neighbourhood of B, full coarse neighbourhood of B',
+// full coarse neighbourhood of B]. Neighbourhoods are sampled in each voxel's
+// local frame (T along the direction field, N the sdf gradient, B = T x N)
+// with trilinear interpolation; the causal part is the half cube on the -T
+// side. Voxels are visited in order of a sweep distance whose gradient is T.
+// Candidates are the approximate nearest neighbour (PCA + nanoflann k-d
+// tree) and, as in Hertzmann et al.'s image analogies, the coherent
+// continuations of the already visited neighbours' sources; a coherent
+// candidate wins unless the nearest neighbour is clearly better. Coherence
+// is what lets a pattern start on a smooth B: B' = B matches the pattern-free
+// parts of A' exactly, but a continued source copies A' as it is, pattern and
+// all.
+//
+// The isotropic variant (blur, dilation) uses one global frame and scanline
+// order.
 #include <cstddef>
 #include <cstdint>
 
@@ -27,25 +38,52 @@ struct AnalogyOptions {
   double pca_variance = 0.95;   ///< PCA keeps this fraction of variance ...
   int max_pca_dims = 24;        ///< ... in at most this many dimensions
   double ann_eps = 0.5;         ///< nanoflann approximation tolerance (0 = exact in PCA space)
+  /// Hertzmann's kappa: a coherent candidate is taken unless the nearest
+  /// neighbour's distance is below the coherent one's / (1 + coherence)^2.
+  /// 0 = nearest neighbour only (no pattern can start on a smooth B).
+  double coherence = 1.0;
+  /// ... plus this fraction of the exemplar's feature variance: on a smooth
+  /// B the pattern-free parts of A' match exactly (distance 0), and without
+  /// an absolute slack they would always beat the continuation of a pattern.
+  double coherence_slack = 0.05;
   /// Culling (values are signed distances, positive outside): voxels whose
   /// current B' (B at the coarsest level, the upsampled coarser B' above) is
   /// farther than this from the surface keep that value without a search
   /// (EMPTY or OPAQUE by the sign). < 0 = automatic: the fine neighbourhood's
-  /// half-width in world units at each level; 0 = no culling.
+  /// half-width at each level plus, outside, how far the pair moves A's
+  /// surface outward (a spike's height) and, inside, inward (a pit's depth);
+  /// 0 = no culling.
   double cull_distance = -1.0;
+  /// Signed distances only: inside parts of B' that touch none of B's
+  /// inside (a spike tip copied into the air) are made empty, and empty
+  /// pockets that touch none of B's outside are filled.
+  bool remove_debris = true;
   std::size_t memory_budget = kDefaultMemoryBudget;
-  std::uint64_t seed = 0;       ///< unused: the synthesis is deterministic
+  std::uint64_t seed = 0;       ///< unused: the synthesis is deterministic (no random choice)
 };
 
 struct AnalogyResult {
   Volume b_prime;              ///< same grid and transform as B
-  std::size_t searched = 0;    ///< voxel searches made, all levels and sweeps
+  std::size_t searched = 0;    ///< voxel visits that searched, all levels and sweeps
+  std::size_t coherent = 0;    ///< of those, visits where a coherent candidate won
   std::size_t culled = 0;      ///< voxel visits skipped by culling
+  std::size_t debris = 0;      ///< voxels changed by remove_debris
 };
 
-/// a, a_prime: same grid, 1 channel; b: 1 channel, any size (same voxel
-/// scale as A assumed). Throws InvalidInput, OverBudget, Cancelled.
+/// Isotropic analogy (global frame, scanline order).
+/// a, a_prime: same grid, 1 channel; b: 1 channel, any size; A and B must
+/// share a voxel size (the pattern is copied voxel for voxel).
+/// Throws InvalidInput, OverBudget, Cancelled.
 AnalogyResult synthesize_analogy(const Volume& a, const Volume& a_prime, const Volume& b,
                                  const AnalogyOptions& opt = {}, ExecContext* ctx = nullptr);
+
+/// Field-aligned analogy. field_a / field_b: 3 channels on A's / B's grid,
+/// the direction the pattern runs at every voxel (e.g. ExemplarPair::field_a
+/// and VolumeFrames::t); it is projected perpendicular to the sdf gradient
+/// at every level. Voxels where the field is zero or not finite are an
+/// InvalidInput only if they lie near the surface.
+AnalogyResult synthesize_analogy(const Volume& a, const Volume& a_prime, const Volume& field_a, const Volume& b,
+                                 const Volume& field_b, const AnalogyOptions& opt = {},
+                                 ExecContext* ctx = nullptr);
 
 }  // namespace exsynth

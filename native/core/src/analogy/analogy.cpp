@@ -1,56 +1,58 @@
 #include "exsynth/analogy.hpp"
 
 #include <algorithm>
-#include <array>
 #include <cmath>
-#include <memory>
+#include <limits>
+#include <numeric>
 #include <string>
 #include <vector>
 
-#include <nanoflann.hpp>
-
+#include "analogy/ann_index.hpp"
+#include "analogy/debris.hpp"
+#include "analogy/local_frames.hpp"
 #include "exsynth/errors.hpp"
 #include "exsynth/parallel.hpp"
 #include "exsynth/pyramid.hpp"
-#include "exsynth/sample.hpp"
 #include "search/pca.hpp"
 
 namespace exsynth {
 namespace {
 
+using analogy::Frame;
+using analogy::trilinear;
 using search::RowMatrixXf;
-using Offset = std::array<int, 3>;
+using Vec3 = Eigen::Vector3f;
 
-// Neighbourhood offsets. The causal part holds the fine cube's voxels that
-// come before the centre in scanline order (z slowest, then y, then x):
-// those are already synthesized when the centre is visited.
+// Neighbourhood offsets in local frame coordinates (T, B, N). The causal
+// part holds the fine cube's offsets that are visited before the centre:
+// the -T half cube in sweep order, or the scanline predecessors (z slowest,
+// then y, then x) in the isotropic variant.
 struct Neighbourhoods {
-  std::vector<Offset> causal, fine, coarse;
-  int dims(bool with_coarse) const { return int(causal.size() + fine.size() + (with_coarse ? 2 * coarse.size() : 0)); }
+  std::vector<Vec3> causal, fine, coarse;
+  int static_dims(bool with_coarse) const { return int(fine.size() + (with_coarse ? 2 * coarse.size() : 0)); }
+  int dims(bool with_coarse) const { return int(causal.size()) + static_dims(with_coarse); }
 };
 
-Neighbourhoods make_neighbourhoods(int fine, int coarse) {
+Neighbourhoods make_neighbourhoods(int fine, int coarse, bool scanline) {
   Neighbourhoods n;
   const int r = fine / 2, rc = coarse / 2;
-  for (int dz = -r; dz <= r; ++dz)
-    for (int dy = -r; dy <= r; ++dy)
-      for (int dx = -r; dx <= r; ++dx) {
-        n.fine.push_back({dx, dy, dz});
-        if (dz < 0 || (dz == 0 && (dy < 0 || (dy == 0 && dx < 0)))) n.causal.push_back({dx, dy, dz});
+  for (int k = -r; k <= r; ++k)
+    for (int j = -r; j <= r; ++j)
+      for (int i = -r; i <= r; ++i) {
+        n.fine.emplace_back(float(i), float(j), float(k));
+        const bool before = scanline ? (k < 0 || (k == 0 && (j < 0 || (j == 0 && i < 0)))) : i < 0;
+        if (before) n.causal.emplace_back(float(i), float(j), float(k));
       }
-  for (int dz = -rc; dz <= rc; ++dz)
-    for (int dy = -rc; dy <= rc; ++dy)
-      for (int dx = -rc; dx <= rc; ++dx) n.coarse.push_back({dx, dy, dz});
+  for (int k = -rc; k <= rc; ++k)
+    for (int j = -rc; j <= rc; ++j)
+      for (int i = -rc; i <= rc; ++i) n.coarse.emplace_back(float(i), float(j), float(k));
   return n;
-}
-
-float clamped(const Volume& v, int x, int y, int z) {
-  return v.at(std::clamp(x, 0, v.nx() - 1), std::clamp(y, 0, v.ny() - 1), std::clamp(z, 0, v.nz() - 1));
 }
 
 // One level's view of a side of the analogy: the "before" volume (A or B),
 // the "after" volume (A' or B', being written for B'), and their next-coarser
-// levels (empty at the coarsest).
+// levels (null at the coarsest). Coarse index = fine index / 2: pyramid
+// levels keep voxel 0's centre.
 struct Side {
   const Volume* before;
   const Volume* after;
@@ -58,34 +60,31 @@ struct Side {
   const Volume* after_coarse;
 };
 
-void feature_vector(const Side& s, const Neighbourhoods& n, int x, int y, int z, float* f) {
-  for (const Offset& o : n.causal) *f++ = clamped(*s.after, x + o[0], y + o[1], z + o[2]);
-  for (const Offset& o : n.fine) *f++ = clamped(*s.before, x + o[0], y + o[1], z + o[2]);
-  if (s.before_coarse) {
-    const int cx = x / 2, cy = y / 2, cz = z / 2;  // pyramid levels keep voxel 0's centre
-    for (const Offset& o : n.coarse) *f++ = clamped(*s.after_coarse, cx + o[0], cy + o[1], cz + o[2]);
-    for (const Offset& o : n.coarse) *f++ = clamped(*s.before_coarse, cx + o[0], cy + o[1], cz + o[2]);
+Vec3 voxel_position(const Volume& v, std::uint32_t i) {
+  const auto nx = std::uint32_t(v.nx()), ny = std::uint32_t(v.ny());
+  return Vec3(float(i % nx), float((i / nx) % ny), float(i / (nx * ny)));
+}
+
+void causal_features(const Side& s, const Neighbourhoods& n, const Vec3& g, const Frame& f, float* out) {
+  for (const Vec3& o : n.causal) {
+    const Vec3 p = g + f * o;
+    *out++ = trilinear(*s.after, p.x(), p.y(), p.z());
   }
 }
 
-class KdIndex {
- public:
-  using Tree = nanoflann::KDTreeEigenMatrixAdaptor<RowMatrixXf, -1, nanoflann::metric_L2_Simple>;
-  explicit KdIndex(const RowMatrixXf& points) : tree_(int(points.cols()), std::cref(points), 16) {
-    tree_.index->buildIndex();
+void static_features(const Side& s, const Neighbourhoods& n, const Vec3& g, const Frame& f, float* out) {
+  for (const Vec3& o : n.fine) {
+    const Vec3 p = g + f * o;
+    *out++ = trilinear(*s.before, p.x(), p.y(), p.z());
   }
-  Eigen::Index nearest(const float* q, float eps) const {
-    Eigen::Index idx = 0;
-    float d2 = 0;
-    nanoflann::KNNResultSet<float, Eigen::Index> result(1);
-    result.init(&idx, &d2);
-    tree_.index->findNeighbors(result, q, nanoflann::SearchParams(32, eps));
-    return idx;
-  }
-
- private:
-  Tree tree_;
-};
+  if (!s.before_coarse) return;
+  const Vec3 gc = 0.5f * g;
+  for (const Volume* v : {s.after_coarse, s.before_coarse})
+    for (const Vec3& o : n.coarse) {
+      const Vec3 p = gc + f * o;
+      *out++ = trilinear(*v, p.x(), p.y(), p.z());
+    }
+}
 
 void check_volume(const Volume& v, const char* name) {
   if (v.empty()) throw InvalidInput(std::string(name) + " is empty; give a volume with at least one voxel");
@@ -96,17 +95,108 @@ void check_volume(const Volume& v, const char* name) {
     if (!std::isfinite(x)) throw InvalidInput(std::string(name) + " has a non-finite value; fix the volume first");
 }
 
-}  // namespace
+std::string size_of(const Volume& v) {
+  return std::to_string(v.nx()) + "x" + std::to_string(v.ny()) + "x" + std::to_string(v.nz());
+}
 
-AnalogyResult synthesize_analogy(const Volume& a, const Volume& a_prime, const Volume& b, const AnalogyOptions& opt,
-                                 ExecContext* ctx) {
+// A field must match its volume's grid and be a usable direction wherever
+// the pattern will be synthesized: near the surface.
+void check_field(const Volume& field, const Volume& sdf, const char* name, const char* volume_name) {
+  if (field.channels() != 3 || field.nx() != sdf.nx() || field.ny() != sdf.ny() || field.nz() != sdf.nz())
+    throw InvalidInput(std::string(name) + " must have 3 channels on " + volume_name + "'s grid (" + size_of(sdf) +
+                       "), got " + size_of(field) + " with " + std::to_string(field.channels()) + " channels");
+  const float near = float(2.0 * sdf.transform().voxel_size);
+  std::size_t bad = 0, surface = 0;
+  for (std::size_t i = 0; i < sdf.voxel_count(); ++i) {
+    if (std::abs(sdf.data()[i]) > near) continue;
+    ++surface;
+    const float* t = field.data() + 3 * i;
+    if (!std::isfinite(t[0]) || !std::isfinite(t[1]) || !std::isfinite(t[2]) ||
+        t[0] * t[0] + t[1] * t[1] + t[2] * t[2] < 1e-12f)
+      ++bad;
+  }
+  if (bad)
+    throw InvalidInput(std::string(name) + " is zero or not finite at " + std::to_string(bad) + " of the " +
+                       std::to_string(surface) + " voxels near " + volume_name +
+                       "'s surface; give a direction at every surface point (or use a field preset)");
+}
+
+// How far the pair moves A's surface: outward (A' has material where A is
+// empty: spikes) and inward (A' is empty where A had material: pits,
+// grooves), measured at the voxels on either surface.
+struct Reach {
+  double outward = 0, inward = 0;
+};
+Reach pair_reach(const Volume& a, const Volume& ap) {
+  Reach r;
+  const float near = float(a.transform().voxel_size);
+  for (std::size_t i = 0; i < a.voxel_count(); ++i) {
+    const float va = a.data()[i], vp = ap.data()[i];
+    if (std::abs(va) > near && std::abs(vp) > near) continue;
+    r.outward = std::max(r.outward, double(va - vp));
+    r.inward = std::max(r.inward, double(vp - va));
+  }
+  return r;
+}
+
+// 1 where |A' - A| > tol, dilated by r voxels (a cube).
+std::vector<unsigned char> change_mask(const Volume& a, const Volume& ap, float tol, int r) {
+  const int nx = a.nx(), ny = a.ny(), nz = a.nz();
+  std::vector<unsigned char> m(a.voxel_count()), tmp(a.voxel_count());
+  for (std::size_t i = 0; i < m.size(); ++i) m[i] = std::abs(ap.data()[i] - a.data()[i]) > tol;
+  // Separable max filter, one axis after another.
+  const int dims[3] = {nx, ny, nz};
+  const std::size_t stride[3] = {1, std::size_t(nx), std::size_t(nx) * ny};
+  for (int axis = 0; axis < 3; ++axis) {
+    for (int z = 0; z < nz; ++z)
+      for (int y = 0; y < ny; ++y)
+        for (int x = 0; x < nx; ++x) {
+          const int c[3] = {x, y, z};
+          const std::size_t i = a.voxel_index(x, y, z);
+          unsigned char v = 0;
+          for (int d = -r; d <= r && !v; ++d) {
+            const int q = c[axis] + d;
+            if (q >= 0 && q < dims[axis]) v = m[std::size_t(std::ptrdiff_t(i) + std::ptrdiff_t(d) * std::ptrdiff_t(stride[axis]))];
+          }
+          tmp[i] = v;
+        }
+    m.swap(tmp);
+  }
+  return m;
+}
+
+Volume upsample(const Volume& coarse, const Volume& like) {
+  Volume out(like.nx(), like.ny(), like.nz(), 1, 0.0f, like.transform());
+  StageProgress quiet(nullptr, {}, 0.0, 0.0, std::size_t(like.nz()));
+  parallel_chunks(std::size_t(like.nz()), 1, quiet, [&](std::size_t z0, std::size_t z1) {
+    for (int z = int(z0); z < int(z1); ++z)
+      for (int y = 0; y < like.ny(); ++y)
+        for (int x = 0; x < like.nx(); ++x) out.at(x, y, z) = trilinear(coarse, 0.5f * x, 0.5f * y, 0.5f * z);
+  });
+  return out;
+}
+
+// The coarser level's sweep distance at this level's voxels (x2: voxel
+// units halve), averaged over the coarse corners that have one.
+std::vector<float> upsample_phi(const Volume& phi_coarse, const Volume& has_coarse, const Volume& level,
+                                const std::vector<std::uint32_t>& voxels) {
+  std::vector<float> out(voxels.size(), 0.0f);
+  if (phi_coarse.empty()) return {};
+  for (std::size_t i = 0; i < voxels.size(); ++i) {
+    const Vec3 g = 0.5f * voxel_position(level, voxels[i]);
+    const float w = trilinear(has_coarse, g.x(), g.y(), g.z());
+    out[i] = w > 1e-6f ? 2.0f * trilinear(phi_coarse, g.x(), g.y(), g.z()) / w : 0.0f;
+  }
+  return out;
+}
+
+AnalogyResult run(const Volume& a, const Volume& a_prime, const Volume* field_a, const Volume& b,
+                  const Volume* field_b, const AnalogyOptions& opt, ExecContext* ctx) {
   check_volume(a, "A");
   check_volume(a_prime, "A'");
   check_volume(b, "B");
   if (a.nx() != a_prime.nx() || a.ny() != a_prime.ny() || a.nz() != a_prime.nz())
-    throw InvalidInput("A and A' must have the same size, got " + std::to_string(a.nx()) + "x" + std::to_string(a.ny()) +
-                       "x" + std::to_string(a.nz()) + " and " + std::to_string(a_prime.nx()) + "x" +
-                       std::to_string(a_prime.ny()) + "x" + std::to_string(a_prime.nz()) +
+    throw InvalidInput("A and A' must have the same size, got " + size_of(a) + " and " + size_of(a_prime) +
                        "; voxelize both on the same grid");
   if (opt.levels < 1 || opt.levels > 6) throw InvalidInput("levels must be between 1 and 6, got " + std::to_string(opt.levels));
   if (opt.fine_size < 3 || opt.fine_size > 9 || opt.fine_size % 2 == 0)
@@ -114,100 +204,229 @@ AnalogyResult synthesize_analogy(const Volume& a, const Volume& a_prime, const V
   if (opt.coarse_size < 1 || opt.coarse_size > 7 || opt.coarse_size % 2 == 0)
     throw InvalidInput("coarse_size must be odd, between 1 and 7, got " + std::to_string(opt.coarse_size));
   if (opt.sweeps < 1 || opt.sweeps > 8) throw InvalidInput("sweeps must be between 1 and 8, got " + std::to_string(opt.sweeps));
+  if (!(opt.coherence >= 0) || !(opt.coherence_slack >= 0))
+    throw InvalidInput("coherence and coherence_slack must be >= 0");
+  if (b.voxel_count() >= std::size_t(std::numeric_limits<std::uint32_t>::max()) ||
+      a.voxel_count() >= std::size_t(std::numeric_limits<std::int32_t>::max()))
+    throw InvalidInput("A or B has too many voxels (limit 2^31); use a lower resolution");
+  const bool aligned = field_a != nullptr;
+  if (aligned) {
+    check_field(*field_a, a, "field_a", "A");
+    check_field(*field_b, b, "field_b", "B");
+  }
 
-  const Neighbourhoods hood = make_neighbourhoods(opt.fine_size, opt.coarse_size);
+  const Neighbourhoods hood = make_neighbourhoods(opt.fine_size, opt.coarse_size, !aligned);
   const int L = opt.levels;
-  // Peak: A's database (features + PCA coefficients) and the pyramids.
-  check_memory_budget(double(a.voxel_count()) * (hood.dims(L > 1) + opt.max_pca_dims) * 4.0 * 1.2 +
-                          double(a.voxel_count() * 2 + b.voxel_count() * 2) * 4.0 * 8.0 / 7.0,
-                      opt.memory_budget, "the analogy on a " + std::to_string(a.nx()) + "x" + std::to_string(a.ny()) +
-                                             "x" + std::to_string(a.nz()) + " exemplar",
-                      "use a smaller exemplar resolution or raise the memory budget");
+  // Peak: A's database (features, coefficients, frames), the pyramids, and
+  // per-B-voxel bookkeeping (B', sources, static projections of the band).
+  check_memory_budget(double(a.voxel_count()) * (hood.dims(L > 1) + 2.0 * opt.max_pca_dims + 9) * 4.0 * 1.2 +
+                          double(a.voxel_count() * 2 + b.voxel_count() * 4) * 4.0 * 8.0 / 7.0 +
+                          double(b.voxel_count()) * 4.0 * 3.0,
+                      opt.memory_budget, "the analogy of a " + size_of(a) + " exemplar onto a " + size_of(b) + " volume",
+                      "use a lower resolution or raise the memory budget");
 
   PyramidOptions popt;
   popt.levels = L;
   const std::vector<Volume> pa = gaussian_pyramid(a, popt), pap = gaussian_pyramid(a_prime, popt),
                             pb = gaussian_pyramid(b, popt);
+  const Volume no_field;
 
+  const Reach reach = pair_reach(a, a_prime);
   AnalogyResult result;
-  Volume bp_coarse;
+  Volume bp_coarse, phi_coarse, has_phi_coarse;
   double work_total = 0, work_done = 0;
   for (const Volume& v : pb) work_total += double(v.voxel_count());
   for (int l = 0; l < L; ++l) {
     const int k = L - 1 - l;  // pyramid index
+    const int scale = 1 << k;
     const bool coarse = l > 0;
-    const Volume& al = pa[k];
-    const Volume& apl = pap[k];
-    const Volume& bl = pb[k];
+    const Volume& al = pa[std::size_t(k)];
+    const Volume& apl = pap[std::size_t(k)];
+    const Volume& bl = pb[std::size_t(k)];
     const double p0 = work_done / work_total;
     work_done += double(bl.voxel_count());
     const double p1 = work_done / work_total;
     const std::string stage = "analogy: level " + std::to_string(l + 1) + "/" + std::to_string(L);
+    // Band searched: within the fine half-width of B''s surface plus, on
+    // each side, as far as the pair moves A's surface (a spike's height out,
+    // a pit's depth in), so one level can grow the whole feature.
+    const double half_width = (opt.fine_size / 2) * bl.transform().voxel_size;
+    const double cull = opt.cull_distance < 0 ? half_width + std::max(reach.outward, reach.inward) : opt.cull_distance;
+    const double cull_out = opt.cull_distance < 0 ? half_width + reach.outward : opt.cull_distance;
+    const double cull_in = opt.cull_distance < 0 ? half_width + reach.inward : opt.cull_distance;
+    const Side a_side{&al, &apl, coarse ? &pa[std::size_t(k + 1)] : nullptr, coarse ? &pap[std::size_t(k + 1)] : nullptr};
 
-    const double cull = opt.cull_distance < 0 ? (opt.fine_size / 2) * bl.transform().voxel_size : opt.cull_distance;
-    const Side a_side{&al, &apl, coarse ? &pa[k + 1] : nullptr, coarse ? &pap[k + 1] : nullptr};
-
-    // A's database: voxels near A's surface when culling (B's searched
-    // voxels are near B's surface; far voxels of A would never match).
-    std::vector<std::array<int, 3>> samples;
-    for (int z = 0; z < al.nz(); ++z)
-      for (int y = 0; y < al.ny(); ++y)
-        for (int x = 0; x < al.nx(); ++x)
-          if (cull <= 0 || std::abs(al.at(x, y, z)) <= 2.0 * cull || std::abs(apl.at(x, y, z)) <= 2.0 * cull)
-            samples.push_back({x, y, z});
-    if (samples.empty()) throw InvalidInput("A has no voxels near its surface at level " + std::to_string(l + 1) +
-                                            "; check that A is a signed distance field (or set cull_distance=0)");
-    const int D = hood.dims(coarse);
-    RowMatrixXf db(Eigen::Index(samples.size()), D);
+    // ---- A's database: the voxels of A that show the change. Parts of A
+    // that A' leaves alone (the underside of a slab with spikes on top) would
+    // teach "no change" and, seen in their own frames, look exactly like the
+    // parts that do change. Kept: voxels within the fine half-width (+1) of a
+    // voxel where A' differs from A, and, when culling, near either surface.
+    // Tolerance: a tenth of a voxel for distances, 1 % of A's range for
+    // densities (whichever is smaller).
+    const auto [lo, hi] = std::minmax_element(al.values().begin(), al.values().end());
+    const float tol = std::min(0.1f * float(al.transform().voxel_size), 0.01f * (*hi - *lo));
+    const std::vector<unsigned char> changed = change_mask(al, apl, tol, opt.fine_size / 2 + 1);
+    std::vector<std::uint32_t> a_voxels;
+    for (std::uint32_t i = 0; i < std::uint32_t(al.voxel_count()); ++i)
+      if (changed[i] && (cull <= 0 || std::abs(al.data()[i]) <= 2.0 * cull || std::abs(apl.data()[i]) <= 2.0 * cull))
+        a_voxels.push_back(i);
+    if (a_voxels.empty())
+      throw InvalidInput("A' does not differ from A near A's surface at level " + std::to_string(l + 1) +
+                         "; give a pair whose A' changes A (and A as a signed distance field, or set cull_distance=0)");
+    const std::vector<Frame> a_frames = analogy::frames_at(al, aligned ? *field_a : no_field, scale, a_voxels, nullptr);
+    const int C = int(hood.causal.size()), D = hood.dims(coarse);
+    RowMatrixXf db(Eigen::Index(a_voxels.size()), D);
     {
-      StageProgress build(ctx, stage + " exemplar features", p0, p0 + 0.2 * (p1 - p0), samples.size());
-      parallel_chunks(samples.size(), 1024, build, [&](std::size_t begin, std::size_t end) {
-        for (std::size_t i = begin; i < end; ++i)
-          feature_vector(a_side, hood, samples[i][0], samples[i][1], samples[i][2], db.row(Eigen::Index(i)).data());
+      StageProgress build(ctx, stage + " exemplar features", p0, p0 + 0.1 * (p1 - p0), a_voxels.size());
+      parallel_chunks(a_voxels.size(), 1024, build, [&](std::size_t begin, std::size_t end) {
+        for (std::size_t i = begin; i < end; ++i) {
+          const Vec3 g = voxel_position(al, a_voxels[i]);
+          float* row = db.row(Eigen::Index(i)).data();
+          causal_features(a_side, hood, g, a_frames[i], row);
+          static_features(a_side, hood, g, a_frames[i], row + C);
+        }
       });
     }
     const search::Pca pca = search::fit_pca(db, opt.pca_variance, opt.max_pca_dims);
     const RowMatrixXf coeffs = pca.project(db);
     RowMatrixXf().swap(db);
-    const KdIndex index(coeffs);
+    const analogy::AnnIndex index(coeffs);
+    std::vector<std::int32_t> row_of(al.voxel_count(), -1);
+    for (std::size_t i = 0; i < a_voxels.size(); ++i) row_of[a_voxels[i]] = std::int32_t(i);
 
-    // B' starts as B at the coarsest level, as the coarser B' upsampled above.
-    Volume bp = coarse ? resize_trilinear(bp_coarse, bl.nx(), bl.ny(), bl.nz()) : bl;
+    // ---- B' starts as B at the coarsest level, as the coarser B' upsampled above.
+    Volume bp = coarse ? upsample(bp_coarse, bl) : bl;
     bp.set_transform(bl.transform());
-    const Side b_side{&bl, &bp, coarse ? &pb[k + 1] : nullptr, coarse ? &bp_coarse : nullptr};
+    const Side b_side{&bl, &bp, coarse ? &pb[std::size_t(k + 1)] : nullptr, coarse ? &bp_coarse : nullptr};
+    // Culling looks at B' as it stands, so a surface a coarser level moved
+    // (a dilation, a spike) keeps its new place: far voxels stay EMPTY or
+    // OPAQUE by their sign.
+    std::vector<std::uint32_t> band;
+    for (std::uint32_t i = 0; i < std::uint32_t(bl.voxel_count()); ++i)
+      if (cull <= 0 || (bp.data()[i] <= cull_out && bp.data()[i] >= -cull_in)) band.push_back(i);
+    result.culled += std::size_t(opt.sweeps) * (bl.voxel_count() - band.size());
+    const std::vector<Frame> b_frames = analogy::frames_at(bl, aligned ? *field_b : no_field, scale, band, nullptr);
 
-    StageProgress synth(ctx, stage + " synthesis", p0 + 0.2 * (p1 - p0), p1,
-                        std::size_t(opt.sweeps) * bl.voxel_count());
-    std::vector<float> f(D);
-    Eigen::RowVectorXf y(pca.dims());
-    for (int sweep = 0; sweep < opt.sweeps; ++sweep)
-      for (int z = 0; z < bl.nz(); ++z)
-        for (int yy = 0; yy < bl.ny(); ++yy) {
-          // Scanline order is causal: one row after another, no parallelism.
-          synth.check();
-          for (int x = 0; x < bl.nx(); ++x) {
-            // Culling looks at B' as it stands (B at the coarsest level, the
-            // upsampled coarser result above), so a surface a coarser level
-            // moved (a dilation) keeps its new place: far voxels stay EMPTY
-            // or OPAQUE by their sign.
-            if (cull > 0 && std::abs(bp.at(x, yy, z)) > cull) {
-              ++result.culled;
-              continue;
-            }
-            feature_vector(b_side, hood, x, yy, z, f.data());
-            y = (Eigen::Map<const Eigen::RowVectorXf>(f.data(), D) - pca.mean) * pca.basis;
-            const auto& s = samples[std::size_t(index.nearest(y.data(), float(opt.ann_eps)))];
-            bp.at(x, yy, z) = apl.at(s[0], s[1], s[2]);
-            ++result.searched;
-          }
-          synth.advance(std::size_t(bl.nx()));
+    // Visit order: scanline (the band is sorted by index) or sweep distance.
+    std::vector<std::uint32_t> order(band.size());
+    std::iota(order.begin(), order.end(), 0u);
+    if (aligned) {
+      const std::vector<float> phi =
+          analogy::sweep_distance(bl.nx(), bl.ny(), bl.nz(), band, b_frames,
+                                  upsample_phi(phi_coarse, has_phi_coarse, bl, band), coarse ? 40 : 400);
+      std::stable_sort(order.begin(), order.end(), [&](std::uint32_t i, std::uint32_t j) { return phi[i] < phi[j]; });
+      phi_coarse = Volume(bl.nx(), bl.ny(), bl.nz(), 1);
+      has_phi_coarse = Volume(bl.nx(), bl.ny(), bl.nz(), 1);
+      for (std::size_t i = 0; i < band.size(); ++i) {
+        phi_coarse.data()[band[i]] = phi[i];
+        has_phi_coarse.data()[band[i]] = 1.0f;
+      }
+    }
+
+    // ---- The static part of every band voxel's PCA coefficients: B and the
+    // coarse level do not change while this level is synthesized, so
+    // (f - mean) * basis = f_causal * basis_causal + [f_static * basis_static - mean * basis].
+    const int d = pca.dims();
+    const Eigen::MatrixXf basis_causal = pca.basis.topRows(C);
+    const Eigen::MatrixXf basis_static = pca.basis.bottomRows(D - C);
+    const Eigen::RowVectorXf mean_proj = pca.mean * pca.basis;
+    RowMatrixXf fixed(Eigen::Index(band.size()), d);
+    {
+      StageProgress prep(ctx, stage + " target features", p0 + 0.1 * (p1 - p0), p0 + 0.2 * (p1 - p0), band.size());
+      parallel_chunks(band.size(), 1024, prep, [&](std::size_t begin, std::size_t end) {
+        Eigen::RowVectorXf f(D - C);
+        for (std::size_t i = begin; i < end; ++i) {
+          static_features(b_side, hood, voxel_position(bl, band[i]), b_frames[i], f.data());
+          fixed.row(Eigen::Index(i)) = f * basis_static - mean_proj;
         }
+      });
+    }
+
+    // ---- Sweeps. Causal: one voxel after another, no parallelism.
+    std::vector<std::int32_t> source(bl.voxel_count(), -1);  // database row each voxel copied
+    const int nx = bl.nx(), ny = bl.ny(), nz = bl.nz();
+    const float kappa = float((1.0 + opt.coherence) * (1.0 + opt.coherence));
+    const float slack = float(opt.coherence_slack * coeffs.squaredNorm() / double(coeffs.rows()));
+    StageProgress synth(ctx, stage + " synthesis", p0 + 0.2 * (p1 - p0), p1, std::size_t(opt.sweeps) * band.size());
+    Eigen::RowVectorXf fc(C), y(d);
+    std::vector<std::int32_t> tried;
+    std::vector<int> votes;
+    for (int sweep = 0; sweep < opt.sweeps; ++sweep)
+      for (std::size_t n = 0; n < order.size(); ++n) {
+        if ((n & 1023) == 0) {
+          synth.check();
+          if (n) synth.advance(1024);
+        }
+        const std::uint32_t i = order[n], v = band[i];
+        const Vec3 g = voxel_position(bl, v);
+        const Frame& f = b_frames[i];
+        causal_features(b_side, hood, g, f, fc.data());
+        y.noalias() = fixed.row(Eigen::Index(i)) + fc * basis_causal;
+
+        // Coherent candidates: each visited neighbour's source, moved back
+        // by the neighbour's offset expressed in the source's frame. Among
+        // those close enough to the nearest neighbour's distance, the one
+        // most neighbours agree on wins (then the closer): a patch of B'
+        // keeps copying one piece of A' rigidly, pattern and all, instead of
+        // drifting to whichever candidate happens to be pattern-free.
+        tried.clear();
+        votes.clear();
+        const int x0 = int(g.x()), y0 = int(g.y()), z0 = int(g.z());
+        for (int dz = -1; dz <= 1; ++dz)
+          for (int dy = -1; dy <= 1; ++dy)
+            for (int dx = -1; dx <= 1; ++dx) {
+              const int qx = x0 + dx, qy = y0 + dy, qz = z0 + dz;
+              if ((dx | dy | dz) == 0 || qx < 0 || qy < 0 || qz < 0 || qx >= nx || qy >= ny || qz >= nz) continue;
+              const std::int32_t s = source[bl.voxel_index(qx, qy, qz)];
+              if (s < 0) continue;
+              const Vec3 local = f.transpose() * Vec3(float(-dx), float(-dy), float(-dz));
+              const Vec3 c = voxel_position(al, a_voxels[std::size_t(s)]) + a_frames[std::size_t(s)] * local;
+              const int cx = int(std::lround(c.x())), cy = int(std::lround(c.y())), cz = int(std::lround(c.z()));
+              if (cx < 0 || cy < 0 || cz < 0 || cx >= al.nx() || cy >= al.ny() || cz >= al.nz()) continue;
+              const std::int32_t r = row_of[al.voxel_index(cx, cy, cz)];
+              if (r < 0) continue;
+              const auto it = std::find(tried.begin(), tried.end(), r);
+              if (it != tried.end()) {
+                ++votes[std::size_t(it - tried.begin())];
+              } else {
+                tried.push_back(r);
+                votes.push_back(1);
+              }
+            }
+        const std::int32_t nearest = std::int32_t(index.nearest(y.data(), float(opt.ann_eps)));
+        const float accept = (coeffs.row(nearest) - y).squaredNorm() * kappa + slack;
+        std::int32_t best = nearest;
+        int best_votes = 0;
+        float best_d = std::numeric_limits<float>::infinity();
+        for (std::size_t c = 0; c < tried.size(); ++c) {
+          const float dist = (coeffs.row(tried[c]) - y).squaredNorm();
+          if (dist > accept || votes[c] < best_votes || (votes[c] == best_votes && dist >= best_d)) continue;
+          best = tried[c], best_votes = votes[c], best_d = dist;
+        }
+        if (best_votes) ++result.coherent;
+        bp.data()[v] = apl.data()[a_voxels[std::size_t(best)]];
+        source[v] = best;
+        ++result.searched;
+      }
     bp_coarse = std::move(bp);
   }
-  if (ctx) ctx->set_progress(1.0);
   result.b_prime = std::move(bp_coarse);
   result.b_prime.set_transform(b.transform());
+  if (opt.remove_debris) result.debris = analogy::remove_debris(result.b_prime, b);
+  if (ctx) ctx->set_progress(1.0);
   return result;
+}
+
+}  // namespace
+
+AnalogyResult synthesize_analogy(const Volume& a, const Volume& a_prime, const Volume& b, const AnalogyOptions& opt,
+                                 ExecContext* ctx) {
+  return run(a, a_prime, nullptr, b, nullptr, opt, ctx);
+}
+
+AnalogyResult synthesize_analogy(const Volume& a, const Volume& a_prime, const Volume& field_a, const Volume& b,
+                                 const Volume& field_b, const AnalogyOptions& opt, ExecContext* ctx) {
+  return run(a, a_prime, &field_a, b, &field_b, opt, ctx);
 }
 
 }  // namespace exsynth

@@ -1,0 +1,15 @@
+#pragma once
+// Clean-up after the analogy: parts of B' that float free of B.
+#include <cstddef>
+
+#include "exsynth/grid.hpp"
+
+namespace exsynth::analogy {
+
+/// Inside parts of b_prime (sdf < 0, 6-connected) that share no voxel with
+/// b's inside are made empty, and empty pockets that share no voxel with
+/// b's outside are filled: a copied spike tip that grew no spike under it,
+/// a bubble no pit opened. Returns the number of voxels changed.
+std::size_t remove_debris(Volume& b_prime, const Volume& b);
+
+}  // namespace exsynth::analogy

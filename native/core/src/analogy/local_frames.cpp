@@ -1,0 +1,127 @@
+#include "analogy/local_frames.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include <Eigen/Geometry>
+#include <Eigen/IterativeLinearSolvers>
+#include <Eigen/SparseCore>
+
+#include "exsynth/parallel.hpp"
+#include "exsynth/sample.hpp"
+
+namespace exsynth::analogy {
+namespace {
+
+Eigen::Vector3f gradient(const Volume& v, int x, int y, int z) {
+  const int p[3] = {x, y, z}, dims[3] = {v.nx(), v.ny(), v.nz()};
+  Eigen::Vector3f g;
+  for (int a = 0; a < 3; ++a) {
+    int lo[3] = {x, y, z}, hi[3] = {x, y, z};
+    lo[a] = std::max(0, p[a] - 1);
+    hi[a] = std::min(dims[a] - 1, p[a] + 1);
+    const int span = hi[a] - lo[a];  // 2 inside, 1 on the border (one-sided)
+    g[a] = span ? (v.at(hi[0], hi[1], hi[2]) - v.at(lo[0], lo[1], lo[2])) / float(span) : 0.0f;
+  }
+  return g;
+}
+
+// A unit vector perpendicular to n: v projected, or, if v is (nearly) along
+// n, the coordinate axis least aligned with n, projected.
+Eigen::Vector3f tangent_of(const Eigen::Vector3f& v, const Eigen::Vector3f& n) {
+  Eigen::Vector3f t = v - v.dot(n) * n;
+  if (t.norm() > 1e-4f) return t.normalized();
+  Eigen::Index axis;
+  n.cwiseAbs().minCoeff(&axis);
+  Eigen::Vector3f e = Eigen::Vector3f::Zero();
+  e[axis] = 1.0f;
+  return (e - e.dot(n) * n).normalized();
+}
+
+}  // namespace
+
+std::vector<Frame> frames_at(const Volume& sdf, const Volume& field, int scale,
+                             const std::vector<std::uint32_t>& voxels, std::size_t* bad_count) {
+  std::vector<Frame> frames(voxels.size(), Frame::Identity());
+  if (field.empty()) {
+    if (bad_count) *bad_count = 0;
+    return frames;
+  }
+  const int nx = sdf.nx(), ny = sdf.ny();
+  std::vector<unsigned char> bad(voxels.size(), 0);
+  StageProgress quiet(nullptr, {}, 0.0, 0.0, voxels.size());
+  parallel_chunks(voxels.size(), 4096, quiet, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t i = begin; i < end; ++i) {
+      const std::uint32_t v = voxels[i];
+      const int x = int(v % std::uint32_t(nx)), y = int((v / std::uint32_t(nx)) % std::uint32_t(ny)),
+                z = int(v / (std::uint32_t(nx) * std::uint32_t(ny)));
+      Eigen::Vector3f n = gradient(sdf, x, y, z);
+      n = n.norm() > 1e-12f ? Eigen::Vector3f(n.normalized()) : Eigen::Vector3f::UnitZ();
+      float t[3];
+      sample_trilinear(field, double(x) * scale, double(y) * scale, double(z) * scale, t);
+      Eigen::Vector3f tv(t[0], t[1], t[2]);
+      if (!tv.allFinite() || tv.norm() < 1e-6f) {
+        bad[i] = 1;
+        tv = Eigen::Vector3f::UnitX();
+      }
+      const Eigen::Vector3f tt = tangent_of(tv, n);
+      frames[i].col(0) = tt;
+      frames[i].col(1) = tt.cross(n);
+      frames[i].col(2) = n;
+    }
+  });
+  if (bad_count) *bad_count = std::size_t(std::count(bad.begin(), bad.end(), 1));
+  return frames;
+}
+
+std::vector<float> sweep_distance(int nx, int ny, int nz, const std::vector<std::uint32_t>& voxels,
+                                  const std::vector<Frame>& frames, const std::vector<float>& guess,
+                                  int iterations) {
+  const std::size_t n = voxels.size();
+  std::vector<float> phi(n, 0.0f);
+  if (n == 0) return phi;
+  auto row_of = [&](std::uint32_t v) -> std::ptrdiff_t {
+    const auto it = std::lower_bound(voxels.begin(), voxels.end(), v);
+    return it != voxels.end() && *it == v ? it - voxels.begin() : -1;
+  };
+  // Least squares over the edges (i, j) to the +x, +y, +z neighbours:
+  // phi_j - phi_i = mean T along the edge. Normal equations: a graph
+  // Laplacian; a tiny diagonal fixes each component's free constant.
+  std::vector<Eigen::Triplet<double>> triplets;
+  triplets.reserve(n * 7);
+  Eigen::VectorXd rhs = Eigen::VectorXd::Zero(Eigen::Index(n));
+  const std::uint32_t step[3] = {1u, std::uint32_t(nx), std::uint32_t(nx) * std::uint32_t(ny)};
+  for (std::size_t i = 0; i < n; ++i) {
+    const std::uint32_t v = voxels[i];
+    const int c[3] = {int(v % std::uint32_t(nx)), int((v / std::uint32_t(nx)) % std::uint32_t(ny)),
+                      int(v / (std::uint32_t(nx) * std::uint32_t(ny)))};
+    const int dims[3] = {nx, ny, nz};
+    triplets.emplace_back(Eigen::Index(i), Eigen::Index(i), 1e-6);
+    for (int a = 0; a < 3; ++a) {
+      if (c[a] + 1 >= dims[a]) continue;
+      const std::ptrdiff_t j = row_of(v + step[a]);
+      if (j < 0) continue;
+      const double d = 0.5 * double(frames[i](a, 0) + frames[std::size_t(j)](a, 0));
+      triplets.emplace_back(Eigen::Index(i), Eigen::Index(i), 1.0);
+      triplets.emplace_back(Eigen::Index(j), Eigen::Index(j), 1.0);
+      triplets.emplace_back(Eigen::Index(i), Eigen::Index(j), -1.0);
+      triplets.emplace_back(Eigen::Index(j), Eigen::Index(i), -1.0);
+      rhs[Eigen::Index(i)] -= d;
+      rhs[Eigen::Index(j)] += d;
+    }
+  }
+  Eigen::SparseMatrix<double> lap{Eigen::Index(n), Eigen::Index(n)};
+  lap.setFromTriplets(triplets.begin(), triplets.end());
+  Eigen::ConjugateGradient<Eigen::SparseMatrix<double>, Eigen::Lower | Eigen::Upper> cg;
+  cg.setMaxIterations(iterations);
+  cg.setTolerance(1e-5);
+  cg.compute(lap);
+  Eigen::VectorXd x0 = Eigen::VectorXd::Zero(Eigen::Index(n));
+  if (guess.size() == n)
+    for (std::size_t i = 0; i < n; ++i) x0[Eigen::Index(i)] = guess[i];
+  const Eigen::VectorXd x = cg.solveWithGuess(rhs, x0);
+  for (std::size_t i = 0; i < n; ++i) phi[i] = float(x[Eigen::Index(i)]);
+  return phi;
+}
+
+}  // namespace exsynth::analogy
