@@ -343,7 +343,13 @@ AnalogyResult run(const Volume& a, const Volume& a_prime, const Volume* field_a,
     }
 
     // ---- Sweeps. Causal: one voxel after another, no parallelism.
-    std::vector<std::int32_t> source(bl.voxel_count(), -1);  // database row each voxel copied
+    // Where each band voxel copied from: a continuous position in A (a
+    // coherent continuation is not rounded, so a patch wrapped over a curved
+    // B does not jitter) and the database row nearest to it.
+    std::vector<std::int32_t> band_of(bl.voxel_count(), -1);
+    for (std::size_t i = 0; i < band.size(); ++i) band_of[band[i]] = std::int32_t(i);
+    std::vector<std::int32_t> source(band.size(), -1);
+    std::vector<Vec3> source_at(band.size());
     const int nx = bl.nx(), ny = bl.ny(), nz = bl.nz();
     const float kappa = float((1.0 + opt.coherence) * (1.0 + opt.coherence));
     const float slack = float(opt.coherence_slack * coeffs.squaredNorm() / double(coeffs.rows()));
@@ -351,6 +357,7 @@ AnalogyResult run(const Volume& a, const Volume& a_prime, const Volume* field_a,
     Eigen::RowVectorXf fc(C), y(d);
     std::vector<std::int32_t> tried;
     std::vector<int> votes;
+    std::vector<Vec3> sums;
     for (int sweep = 0; sweep < opt.sweeps; ++sweep)
       for (std::size_t n = 0; n < order.size(); ++n) {
         if ((n & 1023) == 0) {
@@ -371,16 +378,18 @@ AnalogyResult run(const Volume& a, const Volume& a_prime, const Volume* field_a,
         // drifting to whichever candidate happens to be pattern-free.
         tried.clear();
         votes.clear();
+        sums.clear();
         const int x0 = int(g.x()), y0 = int(g.y()), z0 = int(g.z());
         for (int dz = -1; dz <= 1; ++dz)
           for (int dy = -1; dy <= 1; ++dy)
             for (int dx = -1; dx <= 1; ++dx) {
               const int qx = x0 + dx, qy = y0 + dy, qz = z0 + dz;
               if ((dx | dy | dz) == 0 || qx < 0 || qy < 0 || qz < 0 || qx >= nx || qy >= ny || qz >= nz) continue;
-              const std::int32_t s = source[bl.voxel_index(qx, qy, qz)];
-              if (s < 0) continue;
+              const std::int32_t q = band_of[bl.voxel_index(qx, qy, qz)];
+              if (q < 0 || source[std::size_t(q)] < 0) continue;
+              const std::int32_t s = source[std::size_t(q)];
               const Vec3 local = f.transpose() * Vec3(float(-dx), float(-dy), float(-dz));
-              const Vec3 c = voxel_position(al, a_voxels[std::size_t(s)]) + a_frames[std::size_t(s)] * local;
+              const Vec3 c = source_at[std::size_t(q)] + a_frames[std::size_t(s)] * local;
               const int cx = int(std::lround(c.x())), cy = int(std::lround(c.y())), cz = int(std::lround(c.z()));
               if (cx < 0 || cy < 0 || cz < 0 || cx >= al.nx() || cy >= al.ny() || cz >= al.nz()) continue;
               const std::int32_t r = row_of[al.voxel_index(cx, cy, cz)];
@@ -388,24 +397,29 @@ AnalogyResult run(const Volume& a, const Volume& a_prime, const Volume* field_a,
               const auto it = std::find(tried.begin(), tried.end(), r);
               if (it != tried.end()) {
                 ++votes[std::size_t(it - tried.begin())];
+                sums[std::size_t(it - tried.begin())] += c;
               } else {
                 tried.push_back(r);
                 votes.push_back(1);
+                sums.push_back(c);
               }
             }
         const std::int32_t nearest = std::int32_t(index.nearest(y.data(), float(opt.ann_eps)));
         const float accept = (coeffs.row(nearest) - y).squaredNorm() * kappa + slack;
         std::int32_t best = nearest;
+        Vec3 at = voxel_position(al, a_voxels[std::size_t(nearest)]);
         int best_votes = 0;
         float best_d = std::numeric_limits<float>::infinity();
         for (std::size_t c = 0; c < tried.size(); ++c) {
           const float dist = (coeffs.row(tried[c]) - y).squaredNorm();
           if (dist > accept || votes[c] < best_votes || (votes[c] == best_votes && dist >= best_d)) continue;
           best = tried[c], best_votes = votes[c], best_d = dist;
+          at = sums[c] / float(votes[c]);
         }
         if (best_votes) ++result.coherent;
-        bp.data()[v] = apl.data()[a_voxels[std::size_t(best)]];
-        source[v] = best;
+        bp.data()[v] = trilinear(apl, at.x(), at.y(), at.z());
+        source[i] = best;
+        source_at[i] = at;
         ++result.searched;
       }
     bp_coarse = std::move(bp);
