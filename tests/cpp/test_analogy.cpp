@@ -3,13 +3,17 @@
 #include <gtest/gtest.h>
 
 #include <array>
+#include <map>
 #include <cmath>
 #include <vector>
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 
+#include <tbb/global_control.h>
+
 #include "exsynth/analogy.hpp"
+#include "exsynth/errors.hpp"
 #include "exsynth/pairs.hpp"
 #include "exsynth/rng.hpp"
 
@@ -166,6 +170,14 @@ std::size_t sign_changes(const Volume& v) {
   return n;
 }
 
+// A grid of n^3 voxels of size h centred on the origin.
+GridTransform centred(int n, double h) {
+  GridTransform t;
+  t.voxel_size = h;
+  t.origin = {-0.5 * (n - 1) * h, -0.5 * (n - 1) * h, -0.5 * (n - 1) * h};
+  return t;
+}
+
 // Circles around the z axis: the field of the grooves pair, for any grid
 // centred on the origin.
 Volume around_z(const Volume& like) {
@@ -241,19 +253,96 @@ std::pair<double, double> along_across(const Volume& v, const Volume& frame_sdf,
 
 }  // namespace
 
-TEST(AnalogyExperiment, Measure) {
+// Each pair applied once to a sphere of radius 26 voxels (the pairs'
+// features are ~12 voxels apart) with a field of circles around z.
+struct SphereRun {
+  Volume b, field;
+  AnalogyResult r;
+};
+const SphereRun& on_sphere(PairPreset preset) {
+  static std::map<PairPreset, SphereRun> runs;
+  auto it = runs.find(preset);
+  if (it != runs.end()) return it->second;
   PairOptions po;
   po.resolution = 48;
-  for (PairPreset preset : {PairPreset::Grooves, PairPreset::Spikes, PairPreset::Pits, PairPreset::Holes}) {
-    const ExemplarPair pair = make_exemplar_pair(preset, po);
-    const Volume b = sphere_sdf(pair.a, 0.6);
-    const Volume field = around_z(b);
-    const AnalogyResult r = synthesize_analogy(pair.a, pair.a_prime, pair.field_a, b, field);
-    const auto [bl, bc] = along_across(b, b, field);
-    const auto [pl, pc] = along_across(r.b_prime, b, field);
-    std::printf("%s: area B %zu B' %zu; inside parts B %d B' %d outside parts %d %d; B along/across %.4f/%.4f  B' %.4f/%.4f  searched %zu coherent %zu\n",
-                pair_preset_name(preset), sign_changes(b), sign_changes(r.b_prime), components(b, true),
-                components(r.b_prime, true), components(b, false), components(r.b_prime, false), bl, bc, pl, pc,
-                r.searched, r.coherent);
+  const ExemplarPair pair = make_exemplar_pair(preset, po);
+  const double h = pair.a.transform().voxel_size;
+  SphereRun run;
+  run.b = sphere_sdf(Volume(68, 68, 68, 1, 0.0f, centred(68, h)), 26 * h);
+  run.field = around_z(run.b);
+  run.r = synthesize_analogy(pair.a, pair.a_prime, pair.field_a, run.b, run.field);
+  return runs.emplace(preset, std::move(run)).first->second;
+}
+
+TEST(AnalogyOnASphere, SpikesAddAreaAndVolumeAndStayAttached) {
+  const SphereRun& s = on_sphere(PairPreset::Spikes);
+  EXPECT_GT(double(sign_changes(s.r.b_prime)), 1.3 * double(sign_changes(s.b)));  // measured 1.52x
+  EXPECT_GT(inside_volume(s.r.b_prime), 1.01 * inside_volume(s.b));  // thin cones: measured +2.4 %
+  EXPECT_EQ(components(s.r.b_prime, true), 1);   // no spike floats free
+  EXPECT_EQ(components(s.r.b_prime, false), 1);  // and no bubbles
+  EXPECT_GT(s.r.coherent, s.r.searched / 2);     // patches of A' were copied whole
+}
+
+TEST(AnalogyOnASphere, PitsAndHolesAddAreaAndRemoveVolume) {
+  for (PairPreset preset : {PairPreset::Pits, PairPreset::Holes}) {
+    const SphereRun& s = on_sphere(preset);
+    EXPECT_GT(double(sign_changes(s.r.b_prime)), 1.15 * double(sign_changes(s.b))) << pair_preset_name(preset);
+    EXPECT_LT(inside_volume(s.r.b_prime), inside_volume(s.b)) << pair_preset_name(preset);
+    EXPECT_EQ(components(s.r.b_prime, true), 1) << pair_preset_name(preset);
   }
+}
+
+TEST(AnalogyOnASphere, GroovesRunAlongTheField) {
+  // Measured from B''s signed distance: grooves along T change it across T
+  // (along B = T x N) much more than along T. Spikes are the control: no
+  // direction, ratio about 1.
+  const SphereRun& g = on_sphere(PairPreset::Grooves);
+  const SphereRun& c = on_sphere(PairPreset::Spikes);
+  const auto [g_along, g_across] = along_across(g.r.b_prime, g.b, g.field);
+  const auto [c_along, c_across] = along_across(c.r.b_prime, c.b, c.field);
+  EXPECT_GT(g_across / g_along, 1.5);  // measured 1.9
+  EXPECT_LT(c_across / c_along, 1.2);
+  EXPECT_GT(double(sign_changes(g.r.b_prime)), 1.15 * double(sign_changes(g.b)));
+}
+
+TEST(Analogy, SameInputSameResultWhateverTheThreadCount) {
+  PairOptions po;
+  po.resolution = 32;
+  const ExemplarPair pair = make_exemplar_pair(PairPreset::Spikes, po);
+  const double h = pair.a.transform().voxel_size;
+  const Volume b = sphere_sdf(Volume(40, 40, 40, 1, 0.0f, centred(40, h)), 14 * h);
+  const Volume field = around_z(b);
+  AnalogyResult one;
+  {
+    tbb::global_control single(tbb::global_control::max_allowed_parallelism, 1);
+    one = synthesize_analogy(pair.a, pair.a_prime, pair.field_a, b, field);
+  }
+  const AnalogyResult many = synthesize_analogy(pair.a, pair.a_prime, pair.field_a, b, field);
+  EXPECT_EQ(one.b_prime.values(), many.b_prime.values());
+  EXPECT_EQ(one.searched, many.searched);
+  EXPECT_EQ(one.coherent, many.coherent);
+}
+
+TEST(Analogy, BadFieldsNameTheProblem) {
+  PairOptions po;
+  po.resolution = 16;
+  const ExemplarPair pair = make_exemplar_pair(PairPreset::Spikes, po);
+  const double h = pair.a.transform().voxel_size;
+  const Volume b = sphere_sdf(Volume(20, 20, 20, 1, 0.0f, centred(20, h)), 6 * h);
+  auto message = [&](const Volume& field_a, const Volume& field_b) -> std::string {
+    try {
+      synthesize_analogy(pair.a, pair.a_prime, field_a, b, field_b);
+    } catch (const InvalidInput& e) {
+      return e.what();
+    }
+    return "no error";
+  };
+  const Volume field = around_z(b);
+  const Volume zeros(20, 20, 20, 3, 0.0f, b.transform());
+  EXPECT_THAT(message(pair.field_a, zeros), HasSubstr("field_b is zero or not finite"));
+  Volume nan = field;
+  for (int z = 0; z < 20; ++z) nan.at(10, 4, z, 0) = std::nanf("");  // crosses the surface
+  EXPECT_THAT(message(pair.field_a, nan), HasSubstr("field_b is zero or not finite"));
+  EXPECT_THAT(message(pair.field_a, Volume(20, 20, 20, 1)), HasSubstr("field_b must have 3 channels"));
+  EXPECT_THAT(message(Volume(8, 8, 8, 3, 1.0f), field), HasSubstr("field_a must have 3 channels on A's grid"));
 }
