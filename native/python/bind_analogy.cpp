@@ -55,6 +55,7 @@ void bind_analogy(py::module_& m) {
         out["culled"] = r.culled;
         out["coherent"] = r.coherent;
         out["debris"] = r.debris;
+        out["ann_skipped"] = r.ann_skipped;
         out["b_prime"] = from_volume(std::move(r.b_prime));
         return out;
       },

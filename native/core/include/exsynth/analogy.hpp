@@ -66,6 +66,8 @@ struct AnalogyResult {
   Volume b_prime;              ///< same grid and transform as B
   std::size_t searched = 0;    ///< voxel visits that searched, all levels and sweeps
   std::size_t coherent = 0;    ///< of those, visits where a coherent candidate won
+  std::size_t ann_skipped = 0; ///< of those, visits that needed no k-d tree query (the agreed
+                               ///< coherent candidate was within the slack)
   std::size_t culled = 0;      ///< voxel visits skipped by culling
   std::size_t debris = 0;      ///< voxels changed by remove_debris
 };

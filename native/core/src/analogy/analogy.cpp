@@ -358,6 +358,7 @@ AnalogyResult run(const Volume& a, const Volume& a_prime, const Volume* field_a,
     std::vector<std::int32_t> tried;
     std::vector<int> votes;
     std::vector<Vec3> sums;
+    std::vector<float> cand_dists;
     for (int sweep = 0; sweep < opt.sweeps; ++sweep)
       for (std::size_t n = 0; n < order.size(); ++n) {
         if ((n & 1023) == 0) {
@@ -404,17 +405,33 @@ AnalogyResult run(const Volume& a, const Volume& a_prime, const Volume* field_a,
                 sums.push_back(c);
               }
             }
-        const std::int32_t nearest = std::int32_t(index.nearest(y.data(), float(opt.ann_eps)));
-        const float accept = (coeffs.row(nearest) - y).squaredNorm() * kappa + slack;
-        std::int32_t best = nearest;
-        Vec3 at = voxel_position(al, a_voxels[std::size_t(nearest)]);
-        int best_votes = 0;
-        float best_d = std::numeric_limits<float>::infinity();
+        // The candidate most neighbours agree on (then the closest). If it is
+        // within the slack, the rule below would take it whatever the
+        // nearest neighbour's distance (>= 0): skip the k-d tree query.
+        std::vector<float>& dists = cand_dists;
+        dists.resize(tried.size());
+        std::size_t top = tried.size();
         for (std::size_t c = 0; c < tried.size(); ++c) {
-          const float dist = (coeffs.row(tried[c]) - y).squaredNorm();
-          if (dist > accept || votes[c] < best_votes || (votes[c] == best_votes && dist >= best_d)) continue;
-          best = tried[c], best_votes = votes[c], best_d = dist;
-          at = sums[c] / float(votes[c]);
+          dists[c] = (coeffs.row(tried[c]) - y).squaredNorm();
+          if (top == tried.size() || votes[c] > votes[top] || (votes[c] == votes[top] && dists[c] < dists[top])) top = c;
+        }
+        std::int32_t best;
+        Vec3 at;
+        int best_votes = 0;
+        if (top < tried.size() && dists[top] <= slack) {
+          best = tried[top], best_votes = votes[top], at = sums[top] / float(votes[top]);
+          ++result.ann_skipped;
+        } else {
+          const std::int32_t nearest = std::int32_t(index.nearest(y.data(), float(opt.ann_eps)));
+          const float accept = (coeffs.row(nearest) - y).squaredNorm() * kappa + slack;
+          best = nearest;
+          at = voxel_position(al, a_voxels[std::size_t(nearest)]);
+          float best_d = std::numeric_limits<float>::infinity();
+          for (std::size_t c = 0; c < tried.size(); ++c) {
+            if (dists[c] > accept || votes[c] < best_votes || (votes[c] == best_votes && dists[c] >= best_d)) continue;
+            best = tried[c], best_votes = votes[c], best_d = dists[c];
+            at = sums[c] / float(votes[c]);
+          }
         }
         if (best_votes) ++result.coherent;
         bp.data()[v] = trilinear(apl, at.x(), at.y(), at.z());
