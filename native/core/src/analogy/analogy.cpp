@@ -247,13 +247,17 @@ AnalogyResult run(const Volume& a, const Volume& a_prime, const Volume* field_a,
     work_done += double(bl.voxel_count());
     const double p1 = work_done / work_total;
     const std::string stage = "analogy: level " + std::to_string(l + 1) + "/" + std::to_string(L);
-    // Band searched: within the fine half-width of B''s surface plus, on
-    // each side, as far as the pair moves A's surface (a spike's height out,
-    // a pit's depth in), so one level can grow the whole feature.
+    // Band searched: within the fine half-width of B''s surface plus, at the
+    // coarsest level, as far as the pair moves A's surface on each side (a
+    // spike's height out, a pit's depth in), so that level can grow the
+    // whole feature; finer levels refine the surface the coarser one made,
+    // within one coarser voxel more.
     const double half_width = (opt.fine_size / 2) * bl.transform().voxel_size;
-    const double cull = opt.cull_distance < 0 ? half_width + std::max(reach.outward, reach.inward) : opt.cull_distance;
-    const double cull_out = opt.cull_distance < 0 ? half_width + reach.outward : opt.cull_distance;
-    const double cull_in = opt.cull_distance < 0 ? half_width + reach.inward : opt.cull_distance;
+    const double grow_out = coarse ? 2.0 * bl.transform().voxel_size : reach.outward;
+    const double grow_in = coarse ? 2.0 * bl.transform().voxel_size : reach.inward;
+    const double cull = opt.cull_distance < 0 ? half_width + std::max(grow_out, grow_in) : opt.cull_distance;
+    const double cull_out = opt.cull_distance < 0 ? half_width + grow_out : opt.cull_distance;
+    const double cull_in = opt.cull_distance < 0 ? half_width + grow_in : opt.cull_distance;
     const Side a_side{&al, &apl, coarse ? &pa[std::size_t(k + 1)] : nullptr, coarse ? &pap[std::size_t(k + 1)] : nullptr};
 
     // ---- A's database: the voxels of A that show the change. Parts of A
