@@ -17,6 +17,7 @@ from . import _native, jobs
 from .io import bake as bake_io
 from .io import image as image_io
 from .io import mesh as mesh_io
+from .operators import analogy as analogy_ops
 from .operators import field as field_ops
 from .operators import solid as solid_ops
 from .operators.voxelize import VoxelizeJob
@@ -134,9 +135,45 @@ def _parser():
     p.add_argument("--out", required=True, help="the field: (V, 3) float32 .npy")
     p.set_defaults(run=_run_field)
 
-    p = sub.add_parser("demo", help="voxelize the bundled bunny, solid-texture the cow; render PNGs",
+    p = sub.add_parser(
+        "analogy", help="mesh B + pair A -> A' -> B' (geometric texture by example: .obj, .vdb or .npy)",
+        description="Geometric texture by analogy (Bhat et al. 2004): B' is to B as A' is to A, the "
+        "pattern following a direction field on B. A -> A' is a built-in pair (--preset) or two meshes "
+        "(--a, --a-prime: the same place and units as B, voxelized at B's voxel size). The field is a "
+        "preset (--field-preset, --axis, --curve), for B and for a mesh pair's A. Coordinates stay "
+        "those of the files (no axis conversion: OBJ files are often Y-up, use --axis 0 1 0).",
+    )
+    p.add_argument("--b", required=True, help="the mesh B to texture: .obj, .ply or .stl")
+    pair = p.add_mutually_exclusive_group(required=True)
+    pair.add_argument("--preset", choices=analogy_ops.PRESETS, help="a built-in pair")
+    pair.add_argument("--a", help="the exemplar A (before the change): .obj, .ply or .stl; needs --a-prime")
+    p.add_argument("--a-prime", help="the exemplar A' (A with the change modelled on it); goes with --a")
+    p.add_argument("--field-preset", choices=analogy_ops.FIELD_PRESETS, default="around_axis",
+                   help="the direction field the pattern follows (default around_axis)")
+    p.add_argument("--axis", type=float, nargs=3, metavar=("X", "Y", "Z"), default=(0.0, 0.0, 1.0),
+                   help="around_axis / along_axis: the axis in the files' coordinates (default 0 0 1)")
+    p.add_argument("--curve", help="along_curve: the curve as a polyline, .obj (vertices joined by "
+                   "'l' lines) or .npy (N by 3), in the files' coordinates")
+    p.add_argument("--resolution", type=int, default=128,
+                   help="voxels along B's longest bounding-box side (default 128)")
+    p.add_argument("--pattern-size", type=float, default=0.5,
+                   help="built-in pairs: the pair's cube as a fraction of B's longest side (default 0.5); "
+                   "the pair is made at resolution x pattern size voxels (8..512)")
+    p.add_argument("--out", required=True,
+                   help=".obj (B''s isosurface), .vdb (grids sdf and density) or .npy ((Z, Y, X) float32 "
+                   "signed distance of B', positive outside)")
+    p.add_argument("--dilation", type=float, default=0.15, help="dilate: A' radius minus A's (default 0.15)")
+    p.add_argument("--spike-height", type=float, default=0.3, help="spikes: cone height (default 0.3)")
+    p.add_argument("--seed", type=int, default=0, help="random seed (default 0)")
+    p.add_argument("--memory-budget", type=float, default=0.0,
+                   help="refuse jobs needing more than this many GiB (default: the engine's 8 GiB)")
+    p.set_defaults(run=_run_analogy)
+
+    p = sub.add_parser("demo", help="voxelize the bundled bunny, solid-texture the cow, give the bunny "
+                       "spikes and grooves; render PNGs",
                        description="Voxelize assets/meshes/bunny.obj, solid-texture assets/meshes/cow.obj "
-                       "cut open, and render them with Cycles.")
+                       "cut open, give the bunny spikes and grooves (Geometric Texture), and render them "
+                       "with Cycles.")
     p.add_argument("--assets", required=True, help="the repository's assets/ folder")
     p.add_argument("--out", required=True, help="folder for the PNGs")
     p.add_argument("--resolution", type=int, default=96, help="voxels along the longest side (default 96)")
@@ -186,6 +223,136 @@ def _run_voxelize(args):
         line += f", {len(voxels.surface[1])} triangles -> {args.mesh_out}"
     print(line)
     return 0
+
+
+# ---- analogy -----------------------------------------------------------------
+def _run_analogy(args):
+    b_path = _input_file("--b", args.b, MESH_FORMATS)
+    out_ext = _extension("--out", args.out, (".obj",) + VOXEL_FORMATS)
+    _require(args.resolution > 0, f"--resolution must be > 0 (got {args.resolution})")
+    _require(args.memory_budget >= 0, f"--memory-budget must be >= 0 GiB (got {args.memory_budget})")
+    _require(bool(args.a) == bool(args.a_prime),
+             "--a and --a-prime go together: give both meshes of the pair (or --preset instead)")
+    _require(args.field_preset != "along_curve" or args.curve,
+             "--field-preset along_curve needs --curve CURVE.obj (or .npy)")
+    _require(not args.curve or args.field_preset == "along_curve", "--curve goes with --field-preset along_curve")
+    _require(any(args.axis), "--axis must not be 0 0 0: give the axis direction, e.g. --axis 0 0 1")
+    _require(all(np.isfinite(args.axis)), f"--axis must be finite numbers (got {' '.join(map(str, args.axis))})")
+    if args.preset:
+        _require(args.pattern_size > 0, f"--pattern-size must be > 0 (got {args.pattern_size})")
+        try:
+            analogy_ops.check_settings(args.preset, args.resolution, args.pattern_size)
+        except jobs.InputError as exc:
+            raise UsageError(str(exc).replace("Pattern Size", "--pattern-size").replace("Resolution", "--resolution"))
+    else:
+        a_path = _input_file("--a", args.a, MESH_FORMATS)
+        a_prime_path = _input_file("--a-prime", args.a_prime, MESH_FORMATS)
+        _require(not os.path.samefile(a_path, a_prime_path),
+                 "--a and --a-prime are the same file, so there is no change to copy; give as "
+                 "--a-prime a copy of A with the change modelled on it")
+    curve = _read_curve(args.curve) if args.curve else None
+    field = analogy_ops.FieldSpec(preset=args.field_preset, axis=tuple(args.axis), curve=curve)
+
+    b = _analogy_mesh("--b", b_path, field)
+    job = analogy_ops.GeometricTextureJob(
+        b=b, preset=args.preset or "spikes", resolution=args.resolution, pattern_scale=args.pattern_size,
+        pair_options={"dilate": {"dilation": args.dilation},
+                      "spikes": {"feature_height": args.spike_height}}.get(args.preset, {}),
+        memory_budget=int(args.memory_budget * GIB), seed=args.seed,
+    )
+    if not args.preset:
+        job.a = _analogy_mesh("--a", a_path, field)
+        job.a_prime = _analogy_mesh("--a-prime", a_prime_path, None)
+        try:
+            analogy_ops.check_user_pair_grid(b.vertices, job.a.vertices, job.a_prime.vertices, args.resolution)
+        except jobs.InputError as exc:
+            raise UsageError(f"--a/--a-prime: {str(exc).replace('Resolution', '--resolution')}")
+    runner = jobs.Runner(job)
+    runner.run_here()
+    result = runner.outcome()
+
+    _make_parent(args.out)
+    if out_ext == ".obj":
+        export_obj(args.out, analogy_ops.result_name(result), *result.surface)
+    elif out_ext == ".vdb":
+        h = result.voxel_size
+        density = np.clip(0.5 - result.b_prime / h, 0.0, 1.0).astype(np.float32)
+        _native.write_vdb(args.out, {"sdf": result.b_prime, "density": density}, result.origin, h)
+    else:
+        np.save(args.out, np.ascontiguousarray(result.b_prime, np.float32))
+    nx, ny, nz = result.dims_xyz
+    px, py, pz = result.pair_dims
+    stats = result.stats
+    print(f"analogy: {result.pair} on {os.path.basename(b_path)}, {nx}x{ny}x{nz} voxels of "
+          f"{result.voxel_size:.6g}, pair {px}x{py}x{pz}, field {result.field}; searched {stats['searched']}, "
+          f"coherent {stats['coherent']}, culled {stats['culled']}, debris {stats['debris']}; "
+          f"{len(result.surface[1])} triangles in {runner.seconds:.2f} s -> {args.out}")
+    return 0
+
+
+def _analogy_mesh(arg, path, field):
+    """One mesh file as an analogy input (all its objects together, file coordinates)."""
+    objects = import_mesh(path)
+    verts, tris = mesh_io.world_triangles(objects, bpy.context.evaluated_depsgraph_get())
+    if len(tris) == 0:
+        raise UsageError(f"{arg}: {path} has no faces (the analogy works on solids: give a closed mesh)")
+    name = os.path.splitext(os.path.basename(path))[0]
+    return analogy_ops.MeshInput(name=name, vertices=verts, triangles=tris, field=field)
+
+
+def _read_curve(path):
+    """A polyline from .npy (N by 3) or .obj (vertices joined by edges, in edge order)."""
+    path = _input_file("--curve", path, (".obj", ".npy"))
+    if path.endswith(".npy"):
+        points = _load_npy("--curve", path)
+    else:
+        objects = import_mesh(path)
+        _require(len(objects) == 1, f"--curve: {path} holds {len(objects)} objects; give one polyline")
+        points = _polyline(objects[0].data)
+        bpy.data.batch_remove([objects[0], objects[0].data])
+        _require(points is not None, f"--curve: {path} is not one unbranched polyline (vertices joined by "
+                 "'l' lines, each vertex in at most two)")
+    _require(points.ndim == 2 and points.shape[1] == 3 and len(points) >= 2,
+             f"--curve: {path} must hold N >= 2 points of 3 coordinates (got shape {points.shape})")
+    _require(np.isfinite(points).all(), f"--curve: {path} has non-finite coordinates")
+    return np.ascontiguousarray(points, np.float64)
+
+
+def _polyline(mesh):
+    """The mesh's vertices in edge order (closed loops repeat the first), or
+    None if the edges are not one chain."""
+    n = len(mesh.vertices)
+    co = np.empty(3 * n, np.float32)
+    mesh.vertices.foreach_get("co", co)
+    co = co.reshape(-1, 3)
+    edges = np.empty(2 * len(mesh.edges), np.int32)
+    mesh.edges.foreach_get("vertices", edges)
+    edges = edges.reshape(-1, 2)
+    if len(edges) == 0:
+        return co if n >= 2 else None  # bare vertices: take them in file order
+    neighbours = [[] for _ in range(n)]
+    for i, j in edges:
+        neighbours[i].append(int(j))
+        neighbours[j].append(int(i))
+    used = [i for i in range(n) if neighbours[i]]
+    if any(len(nb) > 2 for nb in neighbours):
+        return None
+    ends = [i for i in used if len(neighbours[i]) == 1]
+    start = ends[0] if ends else used[0]
+    order, prev = [start], None
+    while True:
+        nxt = [j for j in neighbours[order[-1]] if j != prev]
+        if not nxt or (not ends and nxt[0] == start):
+            break
+        prev = order[-1]
+        order.append(nxt[0])
+        if len(order) > n:
+            return None
+    if len(order) != len(used):
+        return None  # several pieces
+    if not ends:
+        order.append(start)
+    return co[order].astype(np.float64)
 
 
 # ---- solid and image ----------------------------------------------------------------
@@ -384,7 +551,8 @@ def _run_demo(args):
     _require(args.solid_size > 0, f"--solid-size must be > 0 (got {args.solid_size})")
     os.makedirs(args.out, exist_ok=True)
     return (demo.run(bunny, args.out, resolution=args.resolution, samples=args.samples)
-            or demo.run_solid(cow, stone, args.out, size=args.solid_size, samples=args.samples))
+            or demo.run_solid(cow, stone, args.out, size=args.solid_size, samples=args.samples)
+            or demo.run_analogy(bunny, args.out, resolution=args.resolution, samples=args.samples))
 
 
 # ---- argument checks ----------------------------------------------------------

@@ -8,6 +8,13 @@ from bpy.props import (
 
 GIB = 1 << 30
 
+# The direction-field presets (Direction Field and Geometric Texture).
+FIELD_PRESET_ITEMS = (
+    ('AROUND_AXIS', "Around Axis", "Circles around the axis through the mesh's centre"),
+    ('ALONG_AXIS', "Along Axis", "The axis, laid flat onto the surface"),
+    ('ALONG_CURVE', "Along Curve", "The direction of the nearest point of a curve object"),
+)
+
 
 class ExSynthSettings(bpy.types.PropertyGroup):
     resolution: IntProperty(
@@ -136,11 +143,7 @@ class ExSynthSettings(bpy.types.PropertyGroup):
     field_preset: EnumProperty(
         name="Preset",
         description="The rule the field follows",
-        items=(
-            ('AROUND_AXIS', "Around Axis", "Circles around the axis through the mesh's centre"),
-            ('ALONG_AXIS', "Along Axis", "The axis, laid flat onto the surface"),
-            ('ALONG_CURVE', "Along Curve", "The direction of the nearest point of a curve object"),
-        ),
+        items=FIELD_PRESET_ITEMS,
         default='AROUND_AXIS',
     )
     field_axis: EnumProperty(
@@ -161,6 +164,94 @@ class ExSynthSettings(bpy.types.PropertyGroup):
         description="The Vector attribute on the Vertex domain holding painted directions "
         "(zero vectors are free and get filled in)",
         default="exsynth_paint",
+    )
+
+    # ---- Geometric Texture ---------------------------------------------------
+    geo_pair_source: EnumProperty(
+        name="Pair Source",
+        description="Where the exemplar pair A → A′ comes from",
+        items=(
+            ('BUILTIN', "Built-in", "A built-in pair: spikes, pits, holes, grooves or dilation"),
+            ('OBJECTS', "Objects", "Two mesh objects you made: A, and A′ with the change modelled on it"),
+        ),
+        default='BUILTIN',
+    )
+    geo_preset: EnumProperty(
+        name="Pair",
+        description="The built-in exemplar pair A → A′ whose change is applied to the active mesh",
+        items=(
+            ('SPIKES', "Spikes", "Flat slab → slab with cones: spikes grow out of the surface"),
+            ('PITS', "Pits", "Flat slab → slab with round dents in rows along the field"),
+            ('HOLES', "Holes", "Flat slab → slab with holes through it (shows on thin parts)"),
+            ('GROOVES', "Grooves", "Cylinder → grooved cylinder: grooves run along the direction field"),
+            ('DILATE', "Dilate", "Sphere → larger sphere: the whole surface moves out"),
+        ),
+        default='SPIKES',
+    )
+    geo_a: PointerProperty(
+        name="A",
+        description="The exemplar before the change (a mesh with faces, in the same units as the "
+        "active mesh: its features are copied at their world size)",
+        type=bpy.types.Object,
+        poll=lambda self, obj: obj.type == 'MESH',
+    )
+    geo_a_prime: PointerProperty(
+        name="A′",
+        description="The exemplar after the change: a copy of A (Shift+D; it may stand beside A) with "
+        "the geometry you want copied (bumps, grooves, ...) modelled on it. It is compared with A in "
+        "its own coordinates placed with A's transform",
+        type=bpy.types.Object,
+        poll=lambda self, obj: obj.type == 'MESH',
+    )
+    geo_field_preset: EnumProperty(
+        name="Field",
+        description="The direction the pattern follows on a mesh without an 'exsynth_field' "
+        "attribute (a mesh with one uses it: Direction Field makes it)",
+        items=FIELD_PRESET_ITEMS,
+        default='AROUND_AXIS',
+    )
+    geo_field_axis: EnumProperty(
+        name="Axis",
+        description="The field preset's axis, in world coordinates",
+        items=(('X', "X", "The world X axis"), ('Y', "Y", "The world Y axis"),
+               ('Z', "Z", "The world Z axis (up)")),
+        default='Z',
+    )
+    geo_field_curve: PointerProperty(
+        name="Curve",
+        description="The curve the field follows (its first and only spline, as evaluated)",
+        type=bpy.types.Object,
+        poll=lambda self, obj: obj.type == 'CURVE',
+    )
+    geo_resolution: IntProperty(
+        name="Resolution",
+        description="Voxels along the longest side of the mesh's bounding box (time and memory grow "
+        "with its cube)",
+        default=128, min=16, max=512, soft_max=256,
+    )
+    geo_pattern_scale: FloatProperty(
+        name="Pattern Size",
+        description="Built-in pairs: how much of the mesh one exemplar cube covers, as a fraction of "
+        "its longest side (smaller: smaller, denser features). The pair is made at Resolution × "
+        "Pattern Size voxels, 8 to 512",
+        default=0.5, min=0.05, max=4.0, soft_max=2.0, precision=2,
+    )
+    geo_dilation: FloatProperty(
+        name="Dilation",
+        description="Dilate: how much larger A′'s sphere is than A's (radius 0.5 in the exemplar's "
+        "[-1, 1] cube; 0.15 moves the surface out by 15 % of half the pattern size)",
+        default=0.15, min=0.02, max=0.4, precision=3,
+    )
+    geo_spike_height: FloatProperty(
+        name="Spike Height",
+        description="Spikes: the cones' height in the exemplar's [-1, 1] cube",
+        default=0.3, min=0.05, max=0.5, precision=3,
+    )
+    geo_make_volume: BoolProperty(
+        name="Make Volume",
+        description="Also add a Volume object with the result's signed distance (grid 'sdf') and "
+        "a density grid",
+        default=False,
     )
 
     @property

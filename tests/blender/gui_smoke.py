@@ -2,7 +2,8 @@
 """Smoke test of the modal (UI) path, which `blender -b` cannot exercise:
 invoke from a 3D viewport, watch progress, finish; invoke again, press Esc
 mid-run, check the scene is unchanged; then open the sidebar's ExSynth tab
-(the Solid Texture panels must draw) and run Solid Texture modally. Needs a display, e.g. (xvfb package):
+(the Solid Texture panels must draw) and run Solid Texture modally; run
+Geometric Texture modally (its panel must draw) and undo it. Needs a display, e.g. (xvfb package):
 
     EXSYNTH_ADDON_DIR=build/addon xvfb-run -a -s "-screen 0 1280x800x24" \
         blender --factory-startup --enable-event-simulate --python tests/blender/gui_smoke.py
@@ -164,10 +165,49 @@ def solid_finish():
     cow = bpy.data.objects["cow"]
     check(cow.material_slots[0].material.name == "cow_solid" and len(cow.data.uv_layers) == 1,
           "Solid Texture bakes an image onto the cow and gives it the material")
+    state.update(step="geo_start")
+    return 0.1
+
+
+# ---- Geometric Texture: its panel draws, its modal run finishes, Ctrl+Z undoes it
+def _in_viewport(fn):
+    win = bpy.context.window_manager.windows[0]
+    area = next(a for a in win.screen.areas if a.type == 'VIEW_3D')
+    region = next(r for r in area.regions if r.type == 'WINDOW')
+    with bpy.context.temp_override(window=win, screen=win.screen, area=area, region=region):
+        return fn()
+
+
+def geo_start():
+    bpy.data.batch_remove(list(bpy.data.objects))
+    bpy.ops.wm.obj_import(filepath=os.path.join(ROOT, "assets", "meshes", "bunny.obj"))
+    bpy.context.scene.exsynth.geo_resolution = 48
+    _record_draws(bpy.types.EXSYNTH_PT_geometric_texture)
+    _in_viewport(lambda: bpy.ops.ed.undo_push(message="before Geometric Texture"))
+    check(invoke_in_viewport("geometric_texture") == {'RUNNING_MODAL'}, "Geometric Texture runs modal")
+    state.update(step="geo_finish", t0=time.monotonic())
+    return 0.05
+
+
+def geo_finish():
+    if "bunny_spikes" not in bpy.data.objects:
+        if time.monotonic() - state["t0"] > 60:
+            check(False, "Geometric Texture finishes within a minute")
+        return 0.05
+    check(names() == ["bunny", "bunny_spikes"], "Geometric Texture adds 'bunny_spikes'")
+    check("EXSYNTH_PT_geometric_texture" in drawn, "the Geometric Texture panel draws without errors")
+    _in_viewport(lambda: bpy.ops.ed.undo())
+    state.update(step="geo_undone")
+    return 0.3
+
+
+def geo_undone():
+    check(names() == ["bunny"], "one undo removes the Geometric Texture result")
     print("gui_smoke: all passed", flush=True)
     os._exit(0)
 
 
 STEPS = {"start": start, "wait_finish": wait_finish, "press_esc": press_esc, "after_esc": after_esc,
-         "solid_start": solid_start, "find_tab": find_tab, "solid_finish": solid_finish}
+         "solid_start": solid_start, "find_tab": find_tab, "solid_finish": solid_finish,
+         "geo_start": geo_start, "geo_finish": geo_finish, "geo_undone": geo_undone}
 bpy.app.timers.register(step, first_interval=1.0)

@@ -1,0 +1,452 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
+"""Geometric Texture: the volume analogy B' : B :: A' : A (Bhat, Ingram &
+Turk 2004) on the active mesh B, field-aligned.
+
+The pair A -> A' is a built-in one (spikes, pits, holes, grooves, dilate:
+`_native.make_exemplar_pair`, with its own direction field) or two mesh
+objects the user picked, voxelized with B's voxel size (their features are
+copied at their world size); A' is read in A's frame, so a copy of A moved
+beside it and then changed is a pair. The pattern follows a direction field on B: the
+mesh's `exsynth_field` point attribute when it has one (the Direction Field
+operator makes it), otherwise a preset (around or along a world axis, along
+a curve) chosen in the panel. A user pair's A gets its field the same way.
+
+make_job() (main thread) reads everything from bpy into a
+GeometricTextureJob of world-space arrays; run() (worker thread) voxelizes,
+builds the volume frames, synthesizes and extracts the isosurface without
+touching bpy.
+"""
+
+import dataclasses
+import math
+
+import bpy
+import numpy as np
+
+from .. import _native
+from ..io import materials
+from ..io import mesh as mesh_io
+from ..io import volume as volume_io
+from ..jobs import InputError, Job, JobOperator
+from . import field as field_ops
+
+PRESETS = ("spikes", "pits", "holes", "grooves", "dilate")
+FIELD_PRESETS = tuple(field_ops.PRESETS.values())  # around_axis, along_axis, along_curve
+PAIR_MIN, PAIR_MAX = 8, 512  # make_exemplar_pair's resolution range
+MAX_GRID_SIDE = 2048  # voxels along one side of a user pair's grid
+NEIGHBOURHOOD_PADDING = 4  # fine 5^3 (2 voxels) + coarse 3^3 at half resolution (2 voxels)
+
+# How far A' reaches beyond A in the pair's own units (the pair spans
+# [-1, 1]^3): the grid around B needs that much room to grow into.
+_PAIR_GROWTH = {"spikes": "feature_height", "dilate": "dilation"}
+_DEFAULT_GROWTH = {"feature_height": 0.3, "dilation": 0.15}
+
+
+def pair_resolution(resolution, pattern_scale):
+    """Voxels along the built-in pair's cube so that its voxels are B's voxels.
+
+    B is voxelized with `resolution` voxels along its longest side L, so
+    its voxel is h = L / resolution. The pair's cube [-1, 1]^3 is to cover
+    `pattern_scale` * L of B, i.e. pattern_scale * resolution of B's voxels:
+    that is the pair's resolution. Depends only on the two settings, so it
+    is known (and checked) before anything runs."""
+    return int(round(pattern_scale * resolution))
+
+
+def voxel_size_for(vertices, resolution):
+    """B's voxel: its longest bounding-box side / resolution (as the voxelizer
+    computes it, from float32 positions)."""
+    v = np.asarray(vertices, np.float32).astype(np.float64)
+    longest = float((v.max(axis=0) - v.min(axis=0)).max())
+    if not longest > 0:
+        raise ValueError("the mesh has zero size (all vertices at one point); give it some extent")
+    return longest / resolution
+
+
+# ---- plain data handed to the worker -------------------------------------------
+@dataclasses.dataclass
+class FieldSpec:
+    """A direction field for one mesh in world space: given vectors at
+    points (from its `exsynth_field` attribute), or a preset rule evaluated
+    on the mesh's triangles in run()."""
+
+    preset: str = "around_axis"
+    axis: tuple = (0.0, 0.0, 1.0)
+    curve: np.ndarray = None  # N by 3 polyline, world space (along_curve)
+    points: np.ndarray = None  # P by 3 world positions of given vectors ...
+    vectors: np.ndarray = None  # ... and the P by 3 world vectors (None: the preset)
+
+    @property
+    def description(self):
+        if self.vectors is not None:
+            return f"'{field_ops.FIELD_ATTRIBUTE}'"
+        if self.preset == "along_curve":
+            return "along curve"
+        axis = {(1.0, 0.0, 0.0): "X", (0.0, 1.0, 0.0): "Y", (0.0, 0.0, 1.0): "Z"}.get(
+            tuple(float(a) for a in self.axis), "({:g}, {:g}, {:g})".format(*self.axis))
+        return f"{self.preset.replace('_', ' ')} {axis}"
+
+    def frames_t(self, mesh, grid, ctx):
+        """The (Z, Y, X, 3) field T on `grid` (a voxelize result of `mesh`)."""
+        if self.vectors is not None:
+            points, vectors = self.points, self.vectors
+        else:
+            points = mesh.vertices
+            vectors = _native.preset_direction_field(
+                mesh.vertices, mesh.triangles, self.preset, axis=self.axis, curve=self.curve, ctx=ctx)
+        return _native.volume_frames(grid["sdf"], grid["origin"], float(grid["voxel_size"]),
+                                     points, vectors, ctx=ctx)["t"]
+
+
+@dataclasses.dataclass
+class MeshInput:
+    name: str
+    vertices: np.ndarray  # V by 3, world space
+    triangles: np.ndarray  # F by 3
+    field: FieldSpec = None  # B and a user pair's A; None for A'
+
+
+@dataclasses.dataclass
+class Textured:
+    """What a GeometricTextureJob returns; arrays are indexed [z, y, x]."""
+
+    name: str  # B's name
+    pair: str  # the built-in preset or A''s name
+    b_prime: np.ndarray  # B' signed distance, world units, positive outside
+    origin: np.ndarray
+    voxel_size: float
+    pair_dims: tuple  # A's grid (x, y, z)
+    field: str  # where B's field came from
+    stats: dict  # searched, coherent, culled, debris
+    surface: tuple  # (vertices V by 3, triangles F by 3), world space
+
+    @property
+    def dims_xyz(self):
+        return tuple(reversed(self.b_prime.shape))
+
+
+@dataclasses.dataclass
+class GeometricTextureJob(Job):
+    b: MeshInput
+    preset: str = "spikes"  # the built-in pair, unless a and a_prime are given
+    a: MeshInput = None
+    a_prime: MeshInput = None
+    resolution: int = 64
+    pattern_scale: float = 0.5  # built-in pairs only
+    pair_options: dict = dataclasses.field(default_factory=dict)
+    memory_budget: int = 0  # bytes; 0 = the engine's default
+    seed: int = 0
+
+    label = "geometric texture"
+
+    @property
+    def user_pair(self):
+        return self.a is not None
+
+    @property
+    def pair_resolution(self):
+        return pair_resolution(self.resolution, self.pattern_scale)
+
+    @property
+    def pair_name(self):
+        return self.a_prime.name if self.user_pair else self.preset
+
+    def padding(self):
+        """Empty voxels around B for a built-in pair: room for A' to grow
+        into, plus the neighbourhoods."""
+        key = _PAIR_GROWTH.get(self.preset)
+        growth = self.pair_options.get(key, _DEFAULT_GROWTH.get(key, 0.0)) if key else 0.0
+        return int(math.ceil(growth * self.pair_resolution / 2.0)) + NEIGHBOURHOOD_PADDING
+
+    def run(self, ctx):
+        h = voxel_size_for(self.b.vertices, self.resolution)
+        common = dict(supersample=2, compute_sdf=True, memory_budget=self.memory_budget, seed=self.seed, ctx=ctx)
+        if self.user_pair:
+            a, a_prime, field_a, growth = self._user_pair(h, common, ctx)
+            padding = int(math.ceil(growth / h)) + NEIGHBOURHOOD_PADDING
+            scale, h_a = 1.0, h
+        else:
+            padding = self.padding()
+        grid = _native.voxelize(self.b.vertices, self.b.triangles, voxel_size=h, padding=padding, **common)
+        b, origin = grid["sdf"], grid["origin"]
+        field_b = self.b.field.frames_t(self.b, grid, ctx)
+        if not self.user_pair:
+            pair = _native.make_exemplar_pair(
+                self.preset, resolution=self.pair_resolution, seed=self.seed, ctx=ctx,
+                memory_budget=self.memory_budget, **self.pair_options,
+            )
+            a, a_prime, field_a = pair["a"], pair["a_prime"], pair["field"]
+            # The analogy matches A's and B's neighbourhoods voxel for voxel,
+            # so both must use the same voxel size. Rather than generating the
+            # pair at 2 / h voxels (B's world units are arbitrary: a 0.15 m
+            # bunny would ask for a 13000^3 pair), the pair stays in its own
+            # units and B is rescaled uniformly into them: one pair unit is
+            # k = h / h_a of B's world units, so B's distances divided by k are
+            # in pair units on a grid of voxel h_a, exactly like A's. B' comes
+            # back times k. The field is a direction: no rescaling.
+            h_a = float(pair["voxel_size"])  # 2 / pair resolution
+            scale = h / h_a
+        res = _native.synthesize_analogy(
+            a, a_prime, np.ascontiguousarray(b / scale, np.float32), field_a=field_a, field_b=field_b,
+            voxel_size=h_a, memory_budget=self.memory_budget, seed=self.seed, ctx=ctx,
+        )
+        b_prime = np.ascontiguousarray(res["b_prime"] * scale, np.float32)
+        surface = _native.isosurface(b_prime, origin, h, isovalue=0.0, ctx=ctx)
+        if len(surface[1]) == 0:
+            raise ValueError(
+                f"the {self.pair_name} analogy left no surface (B' is all inside or all outside). "
+                "Raise the resolution or the pattern size, or try another pair"
+            )
+        return Textured(
+            name=self.b.name, pair=self.pair_name, b_prime=b_prime, origin=origin, voxel_size=h,
+            pair_dims=tuple(reversed(a.shape)), field=self.b.field.description,
+            stats={k: int(res[k]) for k in ("searched", "coherent", "culled", "debris")},
+            surface=surface,
+        )
+
+    def _user_pair(self, h, common, ctx):
+        """A and A' voxelized on one grid (the union of their bounds) with
+        B's voxel size, A's field on it, and how far A' reaches out of A.
+
+        The voxelizer centres its grid on the mesh's bounding box; giving
+        both meshes the union's two corners as extra, unreferenced vertices
+        gives them the same box, hence the same grid (no resampling)."""
+        corners = np.array([np.minimum(self.a.vertices.min(0), self.a_prime.vertices.min(0)),
+                            np.maximum(self.a.vertices.max(0), self.a_prime.vertices.max(0))])
+        grids = []
+        for mesh in (self.a, self.a_prime):
+            verts = np.concatenate([np.asarray(mesh.vertices, np.float64), corners])
+            grids.append(_native.voxelize(verts, mesh.triangles, voxel_size=h,
+                                          padding=NEIGHBOURHOOD_PADDING + 1, **common))
+        a, a_prime = grids[0]["sdf"], grids[1]["sdf"]
+        if float(np.abs(a - a_prime).max()) < 0.1 * h:
+            raise ValueError(
+                f"A' '{self.a_prime.name}' does not differ from A '{self.a.name}' at this resolution "
+                f"(voxel {h:.4g}): the analogy needs a pair whose A' changes A. Pick another A', "
+                "model the change on a copy of A, or raise the resolution"
+            )
+        outside = a_prime < 0
+        growth = max(0.0, float(a[outside].max())) if outside.any() else 0.0
+        field_a = self.a.field.frames_t(self.a, grids[0], ctx)
+        return a, a_prime, field_a, growth
+
+
+# ---- reading the scene (main thread) ----------------------------------------------
+def check_settings(preset, resolution, pattern_scale):
+    """For a built-in pair: an InputError naming the setting to change, or None."""
+    if preset not in PRESETS:
+        raise InputError(f"unknown pair '{preset}'; choose one of {', '.join(PRESETS)}")
+    r_pair = pair_resolution(resolution, pattern_scale)
+    if r_pair < PAIR_MIN:
+        raise InputError(
+            f"the exemplar pair would be only {r_pair} voxels across (Resolution {resolution} × "
+            f"Pattern Size {pattern_scale:g}); it needs at least {PAIR_MIN}. Raise the resolution "
+            "or the pattern size"
+        )
+    if r_pair > PAIR_MAX:
+        raise InputError(
+            f"the exemplar pair would be {r_pair} voxels across (Resolution {resolution} × "
+            f"Pattern Size {pattern_scale:g}); at most {PAIR_MAX}. Lower the resolution or the pattern size"
+        )
+
+
+def check_user_pair_grid(b_vertices, a_vertices, a_prime_vertices, resolution):
+    """A user pair is voxelized with B's voxel: refuse one that is huge next to B."""
+    h = voxel_size_for(b_vertices, resolution)
+    both = np.concatenate([a_vertices, a_prime_vertices])
+    sides = np.ceil((both.max(0) - both.min(0)) / h).astype(np.int64) + 2 * (NEIGHBOURHOOD_PADDING + 1)
+    if sides.max() > MAX_GRID_SIDE:
+        raise InputError(
+            f"A and A′ are {sides.max()} voxels across at B's voxel size (Resolution {resolution}); "
+            f"at most {MAX_GRID_SIDE}. Scale A and A′ down to the size of B's features, or lower the resolution"
+        )
+
+
+def pair_options(settings):
+    """The built-in pair's strength options (pair units: [-1, 1]^3). Grooves
+    keep the pair's default rings: the grooves follow B's field either way
+    (the pair's field runs along its grooves)."""
+    preset = settings.geo_preset.lower()
+    if preset == "dilate":
+        return {"dilation": settings.geo_dilation}
+    if preset == "spikes":
+        return {"feature_height": settings.geo_spike_height}
+    return {}
+
+
+def source_triangles(obj, depsgraph, role, fix):
+    """World-space triangles of a mesh object (modifiers applied), or an
+    InputError saying what to pick."""
+    if obj.type != 'MESH':
+        raise InputError(
+            f"{role} '{obj.name}' is a {obj.type.lower()}, not a mesh. {fix} and run Geometric Texture again"
+        )
+    verts, tris = mesh_io.world_triangles([obj], depsgraph)
+    if len(tris) == 0:
+        raise InputError(
+            f"{role} '{obj.name}' has no faces (only vertices or edges), so it has no inside; the "
+            f"analogy works on solids. Give it faces (Edit Mode, select, F) or {fix[0].lower()}{fix[1:]}"
+        )
+    return verts, tris
+
+
+def attribute_field(obj):
+    """A FieldSpec from the mesh's `exsynth_field` attribute (world space),
+    None when it has none, or an InputError when the field is unusable."""
+    mesh = obj.data
+    if mesh.attributes.get(field_ops.FIELD_ATTRIBUTE) is None:
+        return None
+    field_ops.check_field_slot(obj)
+    vectors = field_ops.read_vectors(mesh, field_ops.FIELD_ATTRIBUTE).astype(np.float64)
+    how_to_fix = (f"Run Direction Field on '{obj.name}' again, or remove the attribute (Properties > "
+                  "Object Data > Attributes) to use the panel's field preset")
+    bad = ~np.isfinite(vectors).all(axis=1)
+    if bad.any():
+        raise InputError(
+            f"the direction field '{field_ops.FIELD_ATTRIBUTE}' of '{obj.name}' is not a number (NaN or "
+            f"infinite) at {int(bad.sum())} of its {len(vectors)} vertices. {how_to_fix}"
+        )
+    matrix = np.array(obj.matrix_world, np.float64)
+    world = vectors @ matrix[:3, :3].T  # tangents transform with the matrix
+    length = np.linalg.norm(world, axis=1)
+    given = length > 1e-8 * max(1.0, float(length.max(initial=0.0)))
+    if not given.any():
+        raise InputError(
+            f"the direction field '{field_ops.FIELD_ATTRIBUTE}' of '{obj.name}' is zero everywhere, "
+            f"so it gives the pattern no direction. {how_to_fix}"
+        )
+    co = np.empty(3 * len(mesh.vertices), np.float32)
+    mesh.vertices.foreach_get("co", co)
+    points = co.reshape(-1, 3).astype(np.float64) @ matrix[:3, :3].T + matrix[:3, 3]
+    # Zero vectors are free (as painted ones are): the frames fill them in
+    # from the nearest given ones.
+    return FieldSpec(points=np.ascontiguousarray(points[given]),
+                     vectors=np.ascontiguousarray(world[given] / length[given, None]))
+
+
+def preset_field(context, settings, obj):
+    """A FieldSpec from the panel's preset, in world space."""
+    preset = field_ops.PRESETS[settings.geo_field_preset]
+    spec = FieldSpec(preset=preset, axis=field_ops.AXES[settings.geo_field_axis])
+    if preset == "along_curve":
+        if settings.geo_field_curve is None:
+            raise InputError(
+                "the Along Curve field preset needs a curve. Pick a curve object in the Geometric "
+                "Texture panel (Curve), or choose another field preset"
+            )
+        local = field_ops.curve_points(settings.geo_field_curve, obj, context.evaluated_depsgraph_get())
+        matrix = np.array(obj.matrix_world, np.float64)
+        spec.curve = local @ matrix[:3, :3].T + matrix[:3, 3]
+    return spec
+
+
+def mesh_input(context, settings, obj, role, fix, with_field=True):
+    verts, tris = source_triangles(obj, context.evaluated_depsgraph_get(), role, fix)
+    field = None
+    if with_field:
+        field = attribute_field(obj) or preset_field(context, settings, obj)
+    return MeshInput(name=obj.name, vertices=verts, triangles=tris, field=field)
+
+
+def user_pair(context, settings, b):
+    """(A, A') MeshInputs from the panel's A and A′ objects, or an InputError."""
+    a_obj, a_prime_obj = settings.geo_a, settings.geo_a_prime
+    for obj, label, what in ((a_obj, "A", "before"), (a_prime_obj, "A′", "after")):
+        if obj is None:
+            raise InputError(
+                f"no {label} picked. Pick the mesh {label} ({what} the change) in the Geometric Texture "
+                "panel, or choose Pair Source: Built-in"
+            )
+    if a_obj == a_prime_obj:
+        raise InputError(
+            f"A and A′ are the same object '{a_obj.name}', so there is no change to copy. Pick as A′ "
+            "a copy of A with the change modelled on it"
+        )
+    a = mesh_input(context, settings, a_obj, "A", "Pick a mesh with faces as A")
+    a_prime = mesh_input(context, settings, a_prime_obj, "A′", "Pick a mesh with faces as A′", with_field=False)
+    # A′ is read in A's frame (its own coordinates placed with A's transform),
+    # so that a copy of A (Shift+D) moved beside it, then changed, is a pair.
+    to_a = np.array(a_obj.matrix_world, np.float64) @ np.linalg.inv(np.array(a_prime_obj.matrix_world, np.float64))
+    a_prime.vertices = a_prime.vertices @ to_a[:3, :3].T + to_a[:3, 3]
+    check_user_pair_grid(b.vertices, a.vertices, a_prime.vertices, settings.geo_resolution)
+    return a, a_prime
+
+
+def result_name(textured):
+    return f"{textured.name}_{textured.pair}"
+
+
+def summary(textured):
+    nx, ny, nz = textured.dims_xyz
+    px, py, pz = textured.pair_dims
+    s = textured.stats
+    return (f"ExSynth: '{result_name(textured)}' from '{textured.name}' ({nx}×{ny}×{nz} voxels, pair "
+            f"{px}×{py}×{pz}, field {textured.field}; searched {s['searched']}, coherent {s['coherent']}, "
+            f"culled {s['culled']}, debris {s['debris']}; {len(textured.surface[1])} triangles)")
+
+
+def add_result_objects(context, textured, make_volume, created):
+    """Mesh object `<B>_<pair>` (+ Volume `<B>_<pair>_volume` with grids
+    sdf = B' and density), in the active collection, selected, the mesh active."""
+    collection = context.collection
+    name = result_name(textured)
+    mesh = created.add(mesh_io.new_mesh(name, *textured.surface, smooth=True))
+    mesh.materials.append(materials.surface_material(created))
+    mesh_obj = created.add(bpy.data.objects.new(mesh.name, mesh))
+    collection.objects.link(mesh_obj)
+    new_objects = [mesh_obj]
+    if make_volume:
+        h = textured.voxel_size
+        # A density too (1 inside, 0 outside, a one-voxel ramp), so that the
+        # shared "ExSynth Volume" material (density attribute) shows it.
+        density = np.clip(0.5 - textured.b_prime / h, 0.0, 1.0).astype(np.float32)
+        path = volume_io.new_cache_path(f"{name}_volume")
+        volume_io.write_vdb(path, {"sdf": textured.b_prime, "density": density},
+                            textured.origin, h, created)
+        vol_obj = volume_io.new_volume_object(f"{name}_volume", path, h, collection, created)
+        vol_obj.data.materials.append(materials.volume_material(created))
+        new_objects.append(vol_obj)
+
+    for obj in list(context.view_layer.objects.selected):
+        obj.select_set(False)
+    for obj in new_objects:
+        obj.select_set(True)
+    context.view_layer.objects.active = mesh_obj
+    return new_objects
+
+
+class EXSYNTH_OT_geometric_texture(JobOperator, bpy.types.Operator):
+    """Give the active mesh the geometry of an exemplar pair A → A′ (built-in spikes, pits, holes, grooves, dilation, or two meshes you model) as a new mesh: B′ is to B as A′ is to A, with the pattern following the mesh's direction field ('exsynth_field') or a field preset. Settings: ExSynth tab of the sidebar"""
+
+    bl_idname = "exsynth.geometric_texture"
+    bl_label = "Geometric Texture"
+    bl_options = {'REGISTER', 'UNDO'}
+
+    def make_job(self, context):
+        if context.mode != 'OBJECT':
+            raise InputError("works in Object Mode only. Press Tab to leave Edit Mode and run it again")
+        settings = context.scene.exsynth
+        if settings.geo_pair_source == 'BUILTIN':
+            check_settings(settings.geo_preset.lower(), settings.geo_resolution, settings.geo_pattern_scale)
+        obj = context.active_object
+        if obj is None:
+            raise InputError(
+                "no active object. Select the mesh to texture (click it in the viewport or the "
+                "Outliner) and run Geometric Texture again"
+            )
+        b = mesh_input(context, settings, obj, "the active object", "Select a mesh object")
+        job = GeometricTextureJob(
+            b=b, preset=settings.geo_preset.lower(), resolution=settings.geo_resolution,
+            pattern_scale=settings.geo_pattern_scale, pair_options=pair_options(settings),
+            memory_budget=settings.memory_budget_bytes, seed=settings.seed,
+        )
+        if settings.geo_pair_source == 'OBJECTS':
+            job.a, job.a_prime = user_pair(context, settings, b)
+        return job
+
+    def finish(self, context, textured, created):
+        add_result_objects(context, textured, context.scene.exsynth.geo_make_volume, created)
+        return summary(textured)
+
+
+CLASSES = (EXSYNTH_OT_geometric_texture,)

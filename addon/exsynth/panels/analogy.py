@@ -1,0 +1,99 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
+"""Geometric Texture in the "ExSynth" sidebar tab: pair, direction field, resolution."""
+
+import bpy
+
+from ..operators.analogy import PAIR_MAX, PAIR_MIN, pair_resolution
+from ..operators.field import FIELD_ATTRIBUTE
+from .main import CATEGORY
+
+
+class _Panel:
+    bl_space_type = 'VIEW_3D'
+    bl_region_type = 'UI'
+    bl_category = CATEGORY
+
+    def _layout(self):
+        layout = self.layout
+        layout.use_property_split = True
+        layout.use_property_decorate = False
+        return layout
+
+
+def _is_mesh(obj):
+    return obj is not None and obj.type == 'MESH'
+
+
+def _has_field(obj):
+    return _is_mesh(obj) and obj.data.attributes.get(FIELD_ATTRIBUTE) is not None
+
+
+class EXSYNTH_PT_geometric_texture(_Panel, bpy.types.Panel):
+    bl_label = "Geometric Texture"
+
+    def draw(self, context):
+        layout = self._layout()
+        settings = context.scene.exsynth
+        obj = context.active_object
+        builtin = settings.geo_pair_source == 'BUILTIN'
+
+        col = layout.column()
+        col.prop(settings, "geo_pair_source", expand=True)
+        if builtin:
+            col.prop(settings, "geo_preset")
+            col.prop(settings, "geo_pattern_scale")
+            if settings.geo_preset == 'DILATE':
+                col.prop(settings, "geo_dilation")
+            elif settings.geo_preset == 'SPIKES':
+                col.prop(settings, "geo_spike_height")
+        else:
+            col.prop(settings, "geo_a")
+            col.prop(settings, "geo_a_prime")
+        col.prop(settings, "geo_resolution")
+
+        # The direction field: the mesh's own attribute wins over the preset.
+        col = layout.column()
+        needs_preset = not _has_field(obj) or (not builtin and not _has_field(settings.geo_a))
+        if _has_field(obj):
+            col.label(text=f"Field: '{FIELD_ATTRIBUTE}' of {obj.name}", icon='ORIENTATION_NORMAL')
+        if needs_preset:
+            col.prop(settings, "geo_field_preset")
+            if settings.geo_field_preset == 'ALONG_CURVE':
+                col.prop(settings, "geo_field_curve")
+            else:
+                col.row().prop(settings, "geo_field_axis", expand=True)
+        col.prop(settings, "geo_make_volume")
+
+        box = layout.box()
+        if not _is_mesh(obj):
+            box.label(text="Select a mesh object", icon='INFO')
+        else:
+            pair = settings.geo_preset.lower() if builtin else getattr(settings.geo_a_prime, "name", "A′")
+            box.label(text=f"{obj.name} → {obj.name}_{pair}", icon='MESH_DATA')
+        if builtin:
+            r_pair = pair_resolution(settings.geo_resolution, settings.geo_pattern_scale)
+            if not PAIR_MIN <= r_pair <= PAIR_MAX:
+                box.label(text=f"Pair {r_pair}³: needs {PAIR_MIN} to {PAIR_MAX}", icon='ERROR')
+            else:
+                box.label(text=f"Exemplar pair {r_pair}³ voxels")
+        elif settings.geo_a is None or settings.geo_a_prime is None:
+            box.label(text="Pick A and A′ (meshes)", icon='ERROR')
+        row = layout.row()
+        row.scale_y = 1.4
+        row.operator("exsynth.geometric_texture", icon='MOD_DISPLACE')
+
+
+class EXSYNTH_PT_geometric_texture_advanced(_Panel, bpy.types.Panel):
+    bl_label = "Advanced"
+    bl_parent_id = "EXSYNTH_PT_geometric_texture"
+    bl_options = {'DEFAULT_CLOSED'}
+
+    def draw(self, context):
+        layout = self._layout()
+        settings = context.scene.exsynth
+        layout.prop(settings, "seed")
+        layout.prop(settings, "memory_budget_gib", text="Memory Budget (GiB)")
+        layout.label(text="Shared with Voxelize", icon='LINKED')
+
+
+CLASSES = (EXSYNTH_PT_geometric_texture, EXSYNTH_PT_geometric_texture_advanced)
