@@ -203,11 +203,29 @@ def geo_finish():
 
 def geo_undone():
     check(names() == ["bunny"], "one undo removes the Geometric Texture result")
+    # The panel's other layout: a mesh pair (A set, A′ not yet), field preset along a curve.
+    settings = bpy.context.scene.exsynth
+    settings.geo_pair_source, settings.geo_field_preset = 'OBJECTS', 'ALONG_CURVE'
+    settings.geo_a = bpy.data.objects["bunny"]
+    drawn.discard("EXSYNTH_PT_geometric_texture")
+    win = bpy.context.window_manager.windows[0]
+    next(a for a in win.screen.areas if a.type == 'VIEW_3D').tag_redraw()
+    state.update(step="geo_pair_drawn", t0=time.monotonic())
+    return 0.3
+
+
+def geo_pair_drawn():
+    if "EXSYNTH_PT_geometric_texture" not in drawn:
+        if time.monotonic() - state["t0"] > 10:
+            check(False, "the Geometric Texture panel draws with a mesh pair")
+        return 0.1
+    check(True, "the Geometric Texture panel draws with a mesh pair")
     print("gui_smoke: all passed", flush=True)
     os._exit(0)
 
 
 STEPS = {"start": start, "wait_finish": wait_finish, "press_esc": press_esc, "after_esc": after_esc,
          "solid_start": solid_start, "find_tab": find_tab, "solid_finish": solid_finish,
-         "geo_start": geo_start, "geo_finish": geo_finish, "geo_undone": geo_undone}
+         "geo_start": geo_start, "geo_finish": geo_finish, "geo_undone": geo_undone,
+         "geo_pair_drawn": geo_pair_drawn}
 bpy.app.timers.register(step, first_interval=1.0)

@@ -193,9 +193,12 @@ class GeometricTextureJob(Job):
         b_prime = np.ascontiguousarray(res["b_prime"] * scale, np.float32)
         surface = _native.isosurface(b_prime, origin, h, isovalue=0.0, ctx=ctx)
         if len(surface[1]) == 0:
+            fix = ("Pick an A′ that is A with a local change (bumps, grooves) at the size of the features "
+                   "you want on B" if self.user_pair else
+                   "Raise the resolution or the pattern size, or try another pair")
             raise ValueError(
-                f"the {self.pair_name} analogy left no surface (B' is all inside or all outside). "
-                "Raise the resolution or the pattern size, or try another pair"
+                f"the analogy with the pair '{self.pair_name}' left no surface (B′ is all inside or all "
+                f"outside). {fix}"
             )
         return Textured(
             name=self.b.name, pair=self.pair_name, b_prime=b_prime, origin=origin, voxel_size=h,
