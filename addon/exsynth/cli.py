@@ -17,6 +17,7 @@ from . import _native, jobs
 from .io import bake as bake_io
 from .io import image as image_io
 from .io import mesh as mesh_io
+from .io.selection import select_only
 from .operators import analogy as analogy_ops
 from .operators import field as field_ops
 from .operators import solid as solid_ops
@@ -455,10 +456,7 @@ def _single_mesh(objects, path):
     obj = objects[0]
     if len(obj.data.polygons) == 0:
         raise UsageError(f"--mesh: {path} has no faces to bake onto")
-    bpy.context.view_layer.objects.active = obj
-    for other in list(bpy.context.view_layer.objects.selected):
-        other.select_set(False)
-    obj.select_set(True)
+    select_only(bpy.context.view_layer, [obj])
     return obj
 
 
@@ -485,9 +483,7 @@ def export_obj(path, name, vertices, triangles):
 
 
 def export_selected_obj(path, obj, uvs=False):
-    for other in list(bpy.context.view_layer.objects.selected):
-        other.select_set(False)
-    obj.select_set(True)
+    select_only(bpy.context.view_layer, [obj])
     bpy.ops.wm.obj_export(filepath=path, export_selected_objects=True, forward_axis='Y',
                           up_axis='Z', export_materials=False, export_uv=uvs)
 

@@ -14,6 +14,7 @@ from mathutils import Vector
 
 from .io import materials
 from .io import mesh as mesh_io
+from .io.selection import select_only
 
 RESOLUTION_PX = (480, 360)
 BUNNY_HEIGHT = 2.0  # the OBJ is ~10 units tall; scaled to a Blender-sized prop
@@ -226,12 +227,7 @@ def _boolean(obj, cutter, operation):
 
 
 def _select(objects):
-    view_layer = bpy.context.view_layer
-    for other in list(view_layer.objects.selected):
-        other.select_set(False)
-    for obj in objects:
-        obj.select_set(True)
-    view_layer.objects.active = objects[0]
+    select_only(bpy.context.view_layer, objects)
 
 
 def _ensure_addon():

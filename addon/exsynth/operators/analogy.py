@@ -27,6 +27,7 @@ from .. import _native
 from ..io import materials
 from ..io import mesh as mesh_io
 from ..io import volume as volume_io
+from ..io.selection import select_only
 from ..jobs import InputError, Job, JobOperator
 from . import field as field_ops
 
@@ -410,11 +411,7 @@ def add_result_objects(context, textured, make_volume, created):
         vol_obj.data.materials.append(materials.volume_material(created))
         new_objects.append(vol_obj)
 
-    for obj in list(context.view_layer.objects.selected):
-        obj.select_set(False)
-    for obj in new_objects:
-        obj.select_set(True)
-    context.view_layer.objects.active = mesh_obj
+    select_only(context.view_layer, new_objects, active=mesh_obj)
     return new_objects
 
 

@@ -11,6 +11,7 @@ from .. import _native
 from ..io import materials
 from ..io import mesh as mesh_io
 from ..io import volume as volume_io
+from ..io.selection import select_only
 from ..jobs import InputError, Job, JobOperator
 
 
@@ -102,11 +103,7 @@ def add_voxel_objects(context, voxels, created):
         collection.objects.link(mesh_obj)
         new_objects.append(mesh_obj)
 
-    for obj in list(context.view_layer.objects.selected):
-        obj.select_set(False)
-    for obj in new_objects:
-        obj.select_set(True)
-    context.view_layer.objects.active = vol_obj
+    select_only(context.view_layer, new_objects, active=vol_obj)
     return new_objects
 
 

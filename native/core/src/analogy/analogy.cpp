@@ -180,8 +180,8 @@ Volume upsample(const Volume& coarse, const Volume& like) {
 // units halve), averaged over the coarse corners that have one.
 std::vector<float> upsample_phi(const Volume& phi_coarse, const Volume& has_coarse, const Volume& level,
                                 const std::vector<std::uint32_t>& voxels) {
-  std::vector<float> out(voxels.size(), 0.0f);
   if (phi_coarse.empty()) return {};
+  std::vector<float> out(voxels.size(), 0.0f);
   for (std::size_t i = 0; i < voxels.size(); ++i) {
     const Vec3 g = 0.5f * voxel_position(level, voxels[i]);
     const float w = trilinear(has_coarse, g.x(), g.y(), g.z());
@@ -239,7 +239,7 @@ AnalogyResult run(const Volume& a, const Volume& a_prime, const Volume* field_a,
   for (int l = 0; l < L; ++l) {
     const int k = L - 1 - l;  // pyramid index
     const int scale = 1 << k;
-    const bool coarse = l > 0;
+    const bool has_coarser = l > 0;  // a coarser level was synthesized before this one
     const Volume& al = pa[std::size_t(k)];
     const Volume& apl = pap[std::size_t(k)];
     const Volume& bl = pb[std::size_t(k)];
@@ -253,12 +253,12 @@ AnalogyResult run(const Volume& a, const Volume& a_prime, const Volume* field_a,
     // whole feature; finer levels refine the surface the coarser one made,
     // within one coarser voxel more.
     const double half_width = (opt.fine_size / 2) * bl.transform().voxel_size;
-    const double grow_out = coarse ? 2.0 * bl.transform().voxel_size : reach.outward;
-    const double grow_in = coarse ? 2.0 * bl.transform().voxel_size : reach.inward;
+    const double grow_out = has_coarser ? 2.0 * bl.transform().voxel_size : reach.outward;
+    const double grow_in = has_coarser ? 2.0 * bl.transform().voxel_size : reach.inward;
     const double cull = opt.cull_distance < 0 ? half_width + std::max(grow_out, grow_in) : opt.cull_distance;
     const double cull_out = opt.cull_distance < 0 ? half_width + grow_out : opt.cull_distance;
     const double cull_in = opt.cull_distance < 0 ? half_width + grow_in : opt.cull_distance;
-    const Side a_side{&al, &apl, coarse ? &pa[std::size_t(k + 1)] : nullptr, coarse ? &pap[std::size_t(k + 1)] : nullptr};
+    const Side a_side{&al, &apl, has_coarser ? &pa[std::size_t(k + 1)] : nullptr, has_coarser ? &pap[std::size_t(k + 1)] : nullptr};
 
     // ---- A's database: the voxels of A that show the change. Parts of A
     // that A' leaves alone (the underside of a slab with spikes on top) would
@@ -278,7 +278,7 @@ AnalogyResult run(const Volume& a, const Volume& a_prime, const Volume* field_a,
       throw InvalidInput("A' does not differ from A near A's surface at level " + std::to_string(l + 1) +
                          "; give a pair whose A' changes A (and A as a signed distance field, or set cull_distance=0)");
     const std::vector<Frame> a_frames = analogy::frames_at(al, aligned ? *field_a : no_field, scale, a_voxels, nullptr);
-    const int C = int(hood.causal.size()), D = hood.dims(coarse);
+    const int C = int(hood.causal.size()), D = hood.dims(has_coarser);
     RowMatrixXf db(Eigen::Index(a_voxels.size()), D);
     {
       StageProgress build(ctx, stage + " exemplar features", p0, p0 + 0.1 * (p1 - p0), a_voxels.size());
@@ -299,9 +299,9 @@ AnalogyResult run(const Volume& a, const Volume& a_prime, const Volume* field_a,
     for (std::size_t i = 0; i < a_voxels.size(); ++i) row_of[a_voxels[i]] = std::int32_t(i);
 
     // ---- B' starts as B at the coarsest level, as the coarser B' upsampled above.
-    Volume bp = coarse ? upsample(bp_coarse, bl) : bl;
+    Volume bp = has_coarser ? upsample(bp_coarse, bl) : bl;
     bp.set_transform(bl.transform());
-    const Side b_side{&bl, &bp, coarse ? &pb[std::size_t(k + 1)] : nullptr, coarse ? &bp_coarse : nullptr};
+    const Side b_side{&bl, &bp, has_coarser ? &pb[std::size_t(k + 1)] : nullptr, has_coarser ? &bp_coarse : nullptr};
     // Culling looks at B' as it stands, so a surface a coarser level moved
     // (a dilation, a spike) keeps its new place: far voxels stay EMPTY or
     // OPAQUE by their sign.
@@ -317,7 +317,7 @@ AnalogyResult run(const Volume& a, const Volume& a_prime, const Volume* field_a,
     if (aligned) {
       const std::vector<float> phi =
           analogy::sweep_distance(bl.nx(), bl.ny(), bl.nz(), band, b_frames,
-                                  upsample_phi(phi_coarse, has_phi_coarse, bl, band), coarse ? 40 : 400);
+                                  upsample_phi(phi_coarse, has_phi_coarse, bl, band), has_coarser ? 40 : 400);
       std::stable_sort(order.begin(), order.end(), [&](std::uint32_t i, std::uint32_t j) { return phi[i] < phi[j]; });
       phi_coarse = Volume(bl.nx(), bl.ny(), bl.nz(), 1);
       has_phi_coarse = Volume(bl.nx(), bl.ny(), bl.nz(), 1);

@@ -9,6 +9,7 @@
 
 #include "exsynth/parallel.hpp"
 #include "exsynth/sample.hpp"
+#include "field/tangent.hpp"
 
 namespace exsynth::analogy {
 namespace {
@@ -24,18 +25,6 @@ Eigen::Vector3f gradient(const Volume& v, int x, int y, int z) {
     g[a] = span ? (v.at(hi[0], hi[1], hi[2]) - v.at(lo[0], lo[1], lo[2])) / float(span) : 0.0f;
   }
   return g;
-}
-
-// A unit vector perpendicular to n: v projected, or, if v is (nearly) along
-// n, the coordinate axis least aligned with n, projected.
-Eigen::Vector3f tangent_of(const Eigen::Vector3f& v, const Eigen::Vector3f& n) {
-  Eigen::Vector3f t = v - v.dot(n) * n;
-  if (t.norm() > 1e-4f) return t.normalized();
-  Eigen::Index axis;
-  n.cwiseAbs().minCoeff(&axis);
-  Eigen::Vector3f e = Eigen::Vector3f::Zero();
-  e[axis] = 1.0f;
-  return (e - e.dot(n) * n).normalized();
 }
 
 }  // namespace
@@ -64,7 +53,8 @@ std::vector<Frame> frames_at(const Volume& sdf, const Volume& field, int scale,
         bad[i] = 1;
         tv = Eigen::Vector3f::UnitX();
       }
-      const Eigen::Vector3f tt = tangent_of(tv, n);
+      const Eigen::Vector3f tt =
+          field::unit_tangent_or(tv.cast<double>(), n.cast<double>(), 1e-4, Eigen::Vector3d::UnitX()).cast<float>();
       frames[i].col(0) = tt;
       frames[i].col(1) = tt.cross(n);
       frames[i].col(2) = n;
