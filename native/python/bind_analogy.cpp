@@ -14,7 +14,7 @@ void bind_analogy(py::module_& m) {
       "synthesize_analogy",
       [](const py::array& a, const py::array& a_prime, const py::array& b, const py::object& field_a,
          const py::object& field_b, double voxel_size, int levels, int fine_size, int coarse_size, int sweeps,
-         double pca_variance, int max_pca_dims, double ann_eps, double coherence, double coherence_slack, double cull_distance, bool remove_debris,
+         double pca_variance, int max_pca_dims, double ann_eps, double coherence, double coherence_slack, double cull_distance, bool remove_debris, const py::object& a_region,
          std::size_t memory_budget, std::uint64_t seed, ExecContext* ctx) {
         for (const auto& [arr, name] : {std::pair<const py::array&, const char*>{a, "a"}, {a_prime, "a_prime"}, {b, "b"}})
           check_shape(arr, name, {-1, -1, -1}, "a (Z, Y, X) float32 volume");
@@ -43,6 +43,12 @@ void bind_analogy(py::module_& m) {
         opt.coherence_slack = coherence_slack;
         opt.cull_distance = cull_distance;
         opt.remove_debris = remove_debris;
+        if (!a_region.is_none()) {
+          const py::array arr = py::array::ensure(a_region);
+          if (!arr) throw InvalidInput("a_region must be a (Z, Y, X) array on A's grid");
+          check_shape(arr, "a_region", {-1, -1, -1}, "a (Z, Y, X) float32 mask on A's grid (> 0.5 = learn here)");
+          opt.a_region = to_volume(arr, "a_region", t);
+        }
         opt.memory_budget = memory_budget ? memory_budget : kDefaultMemoryBudget;
         opt.seed = seed;
         AnalogyResult r;
@@ -63,7 +69,8 @@ void bind_analogy(py::module_& m) {
       py::arg("field_b") = py::none(), py::arg("voxel_size") = 1.0, py::arg("levels") = 2, py::arg("fine_size") = 5, py::arg("coarse_size") = 3, py::arg("sweeps") = 2,
       py::arg("pca_variance") = 0.95, py::arg("max_pca_dims") = 24, py::arg("ann_eps") = 0.5, py::arg("coherence") = 1.0,
       py::arg("coherence_slack") = 0.05,
-      py::arg("cull_distance") = -1.0, py::arg("remove_debris") = true, py::arg("memory_budget") = std::size_t(0), py::arg("seed") = std::uint64_t(0),
+      py::arg("cull_distance") = -1.0, py::arg("remove_debris") = true,
+      py::arg("a_region") = py::none(), py::arg("memory_budget") = std::size_t(0), py::arg("seed") = std::uint64_t(0),
       py::arg("ctx") = static_cast<ExecContext*>(nullptr),
       R"doc(Volume analogy B' : B :: A' : A (Bhat et al. 2004). a, a_prime: (Z, Y, X) float32 on one
 grid; b: (Z, Y, X) float32 on a grid of the same voxel_size (world units; used for automatic
@@ -71,7 +78,8 @@ culling of signed distances: cull_distance < 0 = the fine half-width, 0 = off).
 field_a / field_b: (Z, Y, X, 3) directions on A's / B's grid for the field-aligned analogy
 (frames T, B = T x N, N and sweep order); both None = isotropic (global frame, scanline order).
 coherence: Hertzmann's kappa (0 = nearest neighbour only); remove_debris: drop parts of B' that
-float free of B (signed distances only). Returns {'b_prime', 'searched', 'coherent', 'culled',
+float free of B (signed distances only). a_region: optional (Z, Y, X) mask on A's grid, > 0.5 where
+A' shows the change to learn (e.g. near faces selected on a model; None = wherever A' differs). Returns {'b_prime', 'searched', 'coherent', 'culled',
 'debris'}.)doc");
 }
 

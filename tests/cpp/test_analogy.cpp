@@ -346,3 +346,39 @@ TEST(Analogy, BadFieldsNameTheProblem) {
   EXPECT_THAT(message(pair.field_a, Volume(20, 20, 20, 1)), HasSubstr("field_b must have 3 channels"));
   EXPECT_THAT(message(Volume(8, 8, 8, 3, 1.0f), field), HasSubstr("field_a must have 3 channels on A's grid"));
 }
+
+TEST(Analogy, ARegionLimitsWhatIsLearnt) {
+  PairOptions po;
+  po.resolution = 24;
+  const ExemplarPair pair = make_exemplar_pair(PairPreset::Spikes, po);
+  const double h = pair.a.transform().voxel_size;
+  const Volume b = sphere_sdf(Volume(28, 28, 28, 1, 0.0f, centred(28, h)), 9 * h);
+  const Volume field = around_z(b);
+  // The slab spans voxel rows z = 9..14, the spikes stand on its top: a
+  // region from just under the slab's underside up learns exactly what no
+  // region learns (A' differs from A only above the underside) ...
+  Volume top(24, 24, 24, 1, 0.0f, pair.a.transform()), bottom = top;
+  for (int z = 0; z < 24; ++z)
+    for (int y = 0; y < 24; ++y)
+      for (int x = 0; x < 24; ++x) {
+        if (z >= 8) top.at(x, y, z) = 1.0f;
+        if (z < 6) bottom.at(x, y, z) = 1.0f;  // the air under the slab
+      }
+  AnalogyOptions with_top;
+  with_top.a_region = top;
+  const AnalogyResult all = synthesize_analogy(pair.a, pair.a_prime, pair.field_a, b, field);
+  const AnalogyResult upper = synthesize_analogy(pair.a, pair.a_prime, pair.field_a, b, field, with_top);
+  EXPECT_EQ(all.b_prime.values(), upper.b_prime.values());
+  // ... and the bottom half, where A' is A, has nothing to learn.
+  AnalogyOptions with_bottom;
+  with_bottom.a_region = bottom;
+  try {
+    synthesize_analogy(pair.a, pair.a_prime, pair.field_a, b, field, with_bottom);
+    FAIL() << "no error";
+  } catch (const InvalidInput& e) {
+    EXPECT_THAT(e.what(), HasSubstr("inside a_region"));
+  }
+  AnalogyOptions wrong;
+  wrong.a_region = Volume(8, 8, 8, 1, 1.0f);
+  EXPECT_THROW(synthesize_analogy(pair.a, pair.a_prime, pair.field_a, b, field, wrong), InvalidInput);
+}

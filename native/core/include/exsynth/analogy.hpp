@@ -54,6 +54,10 @@ struct AnalogyOptions {
   /// surface outward (a spike's height) and, inside, inward (a pit's depth);
   /// 0 = no culling.
   double cull_distance = -1.0;
+  /// Optional, 1 channel on A's grid: where A' shows the change to learn
+  /// (> 0.5), e.g. near faces selected on a model whose modified copy is A';
+  /// empty = wherever A' differs from A.
+  Volume a_region;
   /// Signed distances only: inside parts of B' that touch none of B's
   /// inside (a spike tip copied into the air) are made empty, and empty
   /// pockets that touch none of B's outside are filled.

@@ -209,6 +209,10 @@ AnalogyResult run(const Volume& a, const Volume& a_prime, const Volume* field_a,
   if (b.voxel_count() >= std::size_t(std::numeric_limits<std::uint32_t>::max()) ||
       a.voxel_count() >= std::size_t(std::numeric_limits<std::int32_t>::max()))
     throw InvalidInput("A or B has too many voxels (limit 2^31); use a lower resolution");
+  if (!opt.a_region.empty() && (opt.a_region.channels() != 1 || opt.a_region.nx() != a.nx() ||
+                                 opt.a_region.ny() != a.ny() || opt.a_region.nz() != a.nz()))
+    throw InvalidInput("a_region must have 1 channel on A's grid (" + size_of(a) + "), got " + size_of(opt.a_region) +
+                       " with " + std::to_string(opt.a_region.channels()) + " channels");
   const bool aligned = field_a != nullptr;
   if (aligned) {
     check_field(*field_a, a, "field_a", "A");
@@ -271,12 +275,21 @@ AnalogyResult run(const Volume& a, const Volume& a_prime, const Volume* field_a,
     const float tol = std::min(0.1f * float(al.transform().voxel_size), 0.01f * (*hi - *lo));
     const std::vector<unsigned char> changed = change_mask(al, apl, tol, opt.fine_size / 2 + 1);
     std::vector<std::uint32_t> a_voxels;
-    for (std::uint32_t i = 0; i < std::uint32_t(al.voxel_count()); ++i)
-      if (changed[i] && (cull <= 0 || std::abs(al.data()[i]) <= 2.0 * cull || std::abs(apl.data()[i]) <= 2.0 * cull))
-        a_voxels.push_back(i);
+    for (std::uint32_t i = 0; i < std::uint32_t(al.voxel_count()); ++i) {
+      if (!changed[i] || (cull > 0 && std::abs(al.data()[i]) > 2.0 * cull && std::abs(apl.data()[i]) > 2.0 * cull))
+        continue;
+      if (!opt.a_region.empty()) {
+        const Vec3 g = float(scale) * voxel_position(al, i);
+        if (trilinear(opt.a_region, g.x(), g.y(), g.z()) <= 0.5f) continue;
+      }
+      a_voxels.push_back(i);
+    }
     if (a_voxels.empty())
-      throw InvalidInput("A' does not differ from A near A's surface at level " + std::to_string(l + 1) +
-                         "; give a pair whose A' changes A (and A as a signed distance field, or set cull_distance=0)");
+      throw InvalidInput("A' does not differ from A near A's surface" +
+                         std::string(opt.a_region.empty() ? "" : " inside a_region") + " at level " +
+                         std::to_string(l + 1) +
+                         "; give a pair whose A' changes A there (and A as a signed distance field, or set "
+                         "cull_distance=0)");
     const std::vector<Frame> a_frames = analogy::frames_at(al, aligned ? *field_a : no_field, scale, a_voxels, nullptr);
     const int C = int(hood.causal.size()), D = hood.dims(has_coarser);
     RowMatrixXf db(Eigen::Index(a_voxels.size()), D);
