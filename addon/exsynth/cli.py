@@ -149,6 +149,8 @@ def _parser():
     pair.add_argument("--preset", choices=analogy_ops.PRESETS, help="a built-in pair")
     pair.add_argument("--a", help="the exemplar A (before the change): .obj, .ply or .stl; needs --a-prime")
     p.add_argument("--a-prime", help="the exemplar A' (A with the change modelled on it); goes with --a")
+    p.add_argument("--a-region", help="with --a: learn only near these faces of A (a mesh file holding the "
+                   "faces whose change A' shows, e.g. exported selected faces; need not be closed)")
     p.add_argument("--field-preset", choices=analogy_ops.FIELD_PRESETS, default="around_axis",
                    help="the direction field the pattern follows (default around_axis)")
     p.add_argument("--axis", type=float, nargs=3, metavar=("X", "Y", "Z"), default=(0.0, 0.0, 1.0),
@@ -234,6 +236,7 @@ def _run_analogy(args):
     _require(args.memory_budget >= 0, f"--memory-budget must be >= 0 GiB (got {args.memory_budget})")
     _require(bool(args.a) == bool(args.a_prime),
              "--a and --a-prime go together: give both meshes of the pair (or --preset instead)")
+    _require(not args.a_region or args.a, "--a-region goes with --a and --a-prime")
     _require(args.field_preset != "along_curve" or args.curve,
              "--field-preset along_curve needs --curve CURVE.obj (or .npy)")
     _require(not args.curve or args.field_preset == "along_curve", "--curve goes with --field-preset along_curve")
@@ -264,6 +267,11 @@ def _run_analogy(args):
     if not args.preset:
         job.a = _analogy_mesh("--a", a_path, field)
         job.a_prime = _analogy_mesh("--a-prime", a_prime_path, None)
+        if args.a_region:
+            region_path = _input_file("--a-region", args.a_region, MESH_FORMATS)
+            verts, tris = mesh_io.world_triangles(import_mesh(region_path), bpy.context.evaluated_depsgraph_get())
+            _require(len(tris) > 0, f"--a-region: {region_path} has no faces; give the faces of A to learn from")
+            job.a.region = (verts, tris)
         try:
             analogy_ops.check_user_pair_grid(b.vertices, job.a.vertices, job.a_prime.vertices, args.resolution)
         except jobs.InputError as exc:

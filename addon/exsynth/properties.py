@@ -203,6 +203,13 @@ class ExSynthSettings(bpy.types.PropertyGroup):
         type=bpy.types.Object,
         poll=lambda self, obj: obj.type == 'MESH',
     )
+    geo_a_selected_only: BoolProperty(
+        name="Selected Faces of A",
+        description="Learn only from the faces selected on A (select them in Edit Mode, then go back "
+        "to Object Mode): A can then be a whole model and A′ its copy with the change modelled on "
+        "those faces; the rest of the model teaches nothing",
+        default=False,
+    )
     geo_field_preset: EnumProperty(
         name="Field",
         description="The direction the pattern follows on a mesh without an 'exsynth_field' "

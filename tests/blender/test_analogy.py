@@ -248,6 +248,38 @@ def test_user_pair_copies_the_bumps():
     assert radius.min() > 0.8
 
 
+def select_faces(obj, where):
+    """Selects the faces of obj whose local centre satisfies where(centre)."""
+    centres = np.zeros(3 * len(obj.data.polygons), np.float32)
+    obj.data.polygons.foreach_get("center", centres)
+    obj.data.polygons.foreach_set("select", np.array([where(c) for c in centres.reshape(-1, 3)], bool))
+    obj.data.update()
+
+
+def test_selected_faces_of_a_model_and_its_modified_copy():
+    # A is a whole model, A' its copy with bumps on the top faces only:
+    # learning from the selected top faces copies the bumps ...
+    sphere, a, _ = user_pair_scene()
+    select_faces(a, lambda c: c[2] > 0.4)
+    own = own_isosurface(*world_mesh(sphere), RESOLUTION)
+    assert texture(resolution=RESOLUTION, geo_a_selected_only=True) == {'FINISHED'}
+    r_verts, r_tris = world_mesh(bpy.data.objects["Sphere_BumpyBox"])
+    assert enclosed_volume(r_verts, r_tris) > 1.1 * enclosed_volume(*own)
+
+
+def test_selected_faces_that_the_copy_leaves_alone_teach_nothing():
+    # ... while the bottom faces, which A' leaves as they are, have nothing to learn.
+    _, a, _ = user_pair_scene()
+    select_faces(a, lambda c: c[2] < -0.4)
+    run_expecting_error(r"does not differ from A near A's surface inside a_region", geo_a_selected_only=True)
+
+
+def test_selected_faces_of_a_but_none_selected():
+    _, a, _ = user_pair_scene()
+    select_faces(a, lambda c: False)
+    run_expecting_error(r"no faces of A 'Box' are selected", geo_a_selected_only=True)
+
+
 # ---- cancel -------------------------------------------------------------------
 def cancel_in_synthesis(seen):
     """Cancel from another thread once the analogy itself reports progress."""
@@ -447,7 +479,30 @@ def test_cli_user_pair_npy_and_curve(tmp_path):
     assert np.abs(b_prime).max() < 1e3 * h
 
 
+def test_cli_a_region(tmp_path, capsys):
+    # --a-region: the top faces of the box, as a file; the bottom faces, which
+    # the bumpy copy leaves alone, fail with the reason.
+    box, bumpy = tmp_path / "box.obj", tmp_path / "bumpy.obj"
+    for path, height in ((box, 0.0), (bumpy, 0.4)):
+        cli.export_selected_obj(str(path), bump_box(path.stem, height, (0, 0, 0), size=3.0))
+    a_verts, a_tris = world_mesh(bpy.data.objects["box"])
+    for name, keep in (("top", lambda z: z > 1.4), ("bottom", lambda z: z < -1.4)):
+        tris = a_tris[keep(a_verts[a_tris].mean(axis=1)[:, 2])]
+        obj = bpy.data.objects.new(name, mesh_io.new_mesh(name, a_verts, tris))
+        bpy.context.collection.objects.link(obj)
+        cli.export_selected_obj(str(tmp_path / f"{name}.obj"), obj)
+    args = ["analogy", "--b", BUNNY_OBJ, "--a", str(box), "--a-prime", str(bumpy), "--resolution", "40"]
+    out = tmp_path / "b.npy"
+    assert cli.main(args + ["--a-region", str(tmp_path / "top.obj"), "--out", str(out)]) == 0
+    verts, faces = read_obj(BUNNY_OBJ)
+    b = _native.voxelize(verts, faces, resolution=40, padding=4)["sdf"]
+    assert (np.load(out) < 0).sum() > 1.05 * (b < 0).sum()
+    assert cli.main(args + ["--a-region", str(tmp_path / "bottom.obj"), "--out", str(out)]) != 0
+    assert "inside a_region" in capsys.readouterr().err
+
+
 @pytest.mark.parametrize("args, message", [
+    (["--a-region", "r.obj", "--preset", "spikes", "--out", "x.npy"], "--a-region goes with --a"),
     (["--preset", "bumps", "--out", "x.npy"], "invalid choice"),
     (["--preset", "spikes", "--out", "x.png"], "unsupported file type"),
     (["--preset", "spikes", "--pattern-size", "0.1", "--out", "x.npy"], "--pattern-size"),

@@ -105,6 +105,7 @@ class MeshInput:
     vertices: np.ndarray  # V by 3, world space
     triangles: np.ndarray  # F by 3
     field: FieldSpec = None  # B and a user pair's A; None for A'
+    region: tuple = None  # a user pair's A: (vertices, triangles) of the faces to learn from, or None
 
 
 @dataclasses.dataclass
@@ -163,11 +164,12 @@ class GeometricTextureJob(Job):
         h = voxel_size_for(self.b.vertices, self.resolution)
         common = dict(supersample=2, compute_sdf=True, memory_budget=self.memory_budget, seed=self.seed, ctx=ctx)
         if self.user_pair:
-            a, a_prime, field_a, growth = self._user_pair(h, common, ctx)
+            a, a_prime, field_a, growth, region = self._user_pair(h, common, ctx)
             padding = int(math.ceil(growth / h)) + NEIGHBOURHOOD_PADDING
             scale, h_a = 1.0, h
         else:
             padding = self.padding()
+            region = None
         grid = _native.voxelize(self.b.vertices, self.b.triangles, voxel_size=h, padding=padding, **common)
         b, origin = grid["sdf"], grid["origin"]
         field_b = self.b.field.frames_t(self.b, grid, ctx)
@@ -189,7 +191,7 @@ class GeometricTextureJob(Job):
             scale = h / h_a
         res = _native.synthesize_analogy(
             a, a_prime, np.ascontiguousarray(b / scale, np.float32), field_a=field_a, field_b=field_b,
-            voxel_size=h_a, memory_budget=self.memory_budget, seed=self.seed, ctx=ctx,
+            voxel_size=h_a, a_region=region, memory_budget=self.memory_budget, seed=self.seed, ctx=ctx,
         )
         b_prime = np.ascontiguousarray(res["b_prime"] * scale, np.float32)
         surface = _native.isosurface(b_prime, origin, h, isovalue=0.0, ctx=ctx)
@@ -232,7 +234,18 @@ class GeometricTextureJob(Job):
         outside = a_prime < 0
         growth = max(0.0, float(a[outside].max())) if outside.any() else 0.0
         field_a = self.a.field.frames_t(self.a, grids[0], ctx)
-        return a, a_prime, field_a, growth
+        region = None
+        if self.a.region is not None:
+            # Distance to the selected faces on the same grid (an open
+            # surface: the voxelizer's distance is unsigned there); A' may
+            # reach as far as its growth from them.
+            verts, tris = self.a.region
+            near = _native.voxelize(np.concatenate([np.asarray(verts, np.float64), corners]), tris,
+                                    voxel_size=h, padding=NEIGHBOURHOOD_PADDING + 1, **common)["sdf"]
+            if near.shape != a.shape:
+                raise RuntimeError(f"the selected faces' grid {near.shape} is not A's {a.shape}")
+            region = (np.abs(near) <= growth + NEIGHBOURHOOD_PADDING * h).astype(np.float32)
+        return a, a_prime, field_a, growth, region
 
 
 # ---- reading the scene (main thread) ----------------------------------------------
@@ -352,6 +365,29 @@ def mesh_input(context, settings, obj, role, fix, with_field=True):
     return MeshInput(name=obj.name, vertices=verts, triangles=tris, field=field)
 
 
+def selected_faces(obj):
+    """World-space triangles of the faces selected on a mesh object (its
+    own mesh, as last left in Edit Mode), or an InputError."""
+    mesh = obj.data
+    selected = np.zeros(len(mesh.polygons), bool)
+    mesh.polygons.foreach_get("select", selected)
+    if not selected.any():
+        raise InputError(
+            f"no faces of A '{obj.name}' are selected. Select the faces whose change A′ shows (Tab into "
+            "Edit Mode, face select, then Tab back), or untick Selected Faces of A"
+        )
+    mesh.calc_loop_triangles()
+    tris = np.zeros(3 * len(mesh.loop_triangles), np.int32)
+    mesh.loop_triangles.foreach_get("vertices", tris)
+    owner = np.zeros(len(mesh.loop_triangles), np.int32)
+    mesh.loop_triangles.foreach_get("polygon_index", owner)
+    co = np.zeros(3 * len(mesh.vertices), np.float32)
+    mesh.vertices.foreach_get("co", co)
+    matrix = np.array(obj.matrix_world, np.float64)
+    verts = co.reshape(-1, 3).astype(np.float64) @ matrix[:3, :3].T + matrix[:3, 3]
+    return verts, tris.reshape(-1, 3)[selected[owner]]
+
+
 def user_pair(context, settings, b):
     """(A, A') MeshInputs from the panel's A and A′ objects, or an InputError."""
     a_obj, a_prime_obj = settings.geo_a, settings.geo_a_prime
@@ -367,6 +403,8 @@ def user_pair(context, settings, b):
             "a copy of A with the change modelled on it"
         )
     a = mesh_input(context, settings, a_obj, "A", "Pick a mesh with faces as A")
+    if settings.geo_a_selected_only:
+        a.region = selected_faces(a_obj)
     a_prime = mesh_input(context, settings, a_prime_obj, "A′", "Pick a mesh with faces as A′", with_field=False)
     # A′ is read in A's frame (its own coordinates placed with A's transform),
     # so that a copy of A (Shift+D) moved beside it, then changed, is a pair.

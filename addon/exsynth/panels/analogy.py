@@ -49,6 +49,7 @@ class EXSYNTH_PT_geometric_texture(_Panel, bpy.types.Panel):
         else:
             col.prop(settings, "geo_a")
             col.prop(settings, "geo_a_prime")
+            col.prop(settings, "geo_a_selected_only")
         col.prop(settings, "geo_resolution")
 
         # The direction field: the mesh's own attribute wins over the preset.
