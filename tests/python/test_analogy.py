@@ -86,6 +86,21 @@ def test_field_aligned_analogy_is_deterministic(bunny):
     np.testing.assert_array_equal(one["b_prime"], two["b_prime"])
 
 
+def test_a_region_restricts_what_is_learnt():
+    pair = _native.make_exemplar_pair("spikes", resolution=16)
+    h, a = pair["voxel_size"], pair["a"]
+    args = dict(field_a=pair["field"], field_b=pair["field"], voxel_size=h)
+    below = np.zeros_like(a)
+    below[:4] = 1  # the air under the slab: A' is A there
+    with pytest.raises(_native.InvalidInputError, match="inside a_region"):
+        _native.synthesize_analogy(a, pair["a_prime"], a, a_region=below, **args)
+    with pytest.raises(_native.InvalidInputError, match="a_region must have 1 channel on A's grid"):
+        _native.synthesize_analogy(a, pair["a_prime"], a, a_region=np.ones((4, 4, 4), np.float32), **args)
+    everywhere = _native.synthesize_analogy(a, pair["a_prime"], a, a_region=np.ones_like(a), **args)
+    default = _native.synthesize_analogy(a, pair["a_prime"], a, **args)
+    np.testing.assert_array_equal(everywhere["b_prime"], default["b_prime"])
+
+
 def test_bad_fields():
     pair = _native.make_exemplar_pair("spikes", resolution=16)
     h = pair["voxel_size"]
