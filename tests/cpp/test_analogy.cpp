@@ -276,8 +276,8 @@ const SphereRun& on_sphere(PairPreset preset) {
 
 TEST(AnalogyOnASphere, SpikesAddAreaAndVolumeAndStayAttached) {
   const SphereRun& s = on_sphere(PairPreset::Spikes);
-  EXPECT_GT(double(sign_changes(s.r.b_prime)), 1.3 * double(sign_changes(s.b)));  // measured 1.52x
-  EXPECT_GT(inside_volume(s.r.b_prime), 1.01 * inside_volume(s.b));  // thin cones: measured +2.4 %
+  EXPECT_GT(double(sign_changes(s.r.b_prime)), 1.3 * double(sign_changes(s.b)));  // measured 1.58x
+  EXPECT_GT(inside_volume(s.r.b_prime), 1.01 * inside_volume(s.b));  // thin cones: measured +2.9 %
   EXPECT_EQ(components(s.r.b_prime, true), 1);   // no spike floats free
   EXPECT_EQ(components(s.r.b_prime, false), 1);  // and no bubbles
   EXPECT_GT(s.r.coherent, s.r.searched / 2);     // patches of A' were copied whole
