@@ -46,6 +46,13 @@ class Job:
     def run(self, ctx):
         raise NotImplementedError
 
+    @staticmethod
+    def share(ctx, lo, hi):
+        """Give the next engine call the part [lo, hi] of the job's progress
+        bar (a job of several calls: one bar, not one per call)."""
+        if ctx is not None:
+            ctx.set_span(lo, hi)
+
 
 class Runner:
     """Runs one Job, on a worker thread (``start``) or here (``run_here``)."""

@@ -58,6 +58,8 @@ void bind_core(py::module_& m) {
       .def_property_readonly("cancelled", &ExecContext::cancelled)
       .def_property_readonly("progress", &ExecContext::progress)
       .def_property_readonly("stage", &ExecContext::stage)
+      .def("set_span", &ExecContext::set_span, py::arg("lo"), py::arg("hi"),
+           "Give the next call the share [lo, hi] of the progress bar: its own 0..1 then reads lo..hi.")
       .def("__repr__", [](const ExecContext& c) {
         return "<ExecContext stage='" + c.stage() + "' progress=" + std::to_string(c.progress()) +
                (c.cancelled() ? " cancelled>" : ">");

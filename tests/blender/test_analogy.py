@@ -315,6 +315,39 @@ def test_cancel_while_the_analogy_runs(bunny):
     assert scene_state() == before
 
 
+@pytest.mark.parametrize("pair", ["builtin", "objects"])
+def test_one_progress_bar_for_the_whole_job(bunny, pair):
+    # Voxelize, frames, pair, analogy and isosurface share one bar: it never
+    # goes back, and the analogy has most of it.
+    samples = []
+
+    def hook(ctx):
+        def watch():
+            while not done.is_set():
+                samples.append((ctx.progress, ctx.stage))
+                time.sleep(0.0005)
+
+        threading.Thread(target=watch, daemon=True).start()
+
+    done = threading.Event()
+    if pair == "objects":
+        user_pair_scene()
+        select_faces(bpy.context.scene.exsynth.geo_a, lambda c: c[2] > 0.4)
+        bpy.context.scene.exsynth.geo_a_selected_only = True
+    jobs.job_started_hooks.append(hook)
+    try:
+        assert texture("SPIKES", resolution=RESOLUTION) == {'FINISHED'}
+    finally:
+        done.set()
+        jobs.job_started_hooks.remove(hook)
+    progress = [p for p, _ in samples]
+    assert len(progress) > 10
+    back = [(a, b) for a, b in zip(samples, samples[1:]) if b[0] < a[0]]
+    assert not back
+    analogy = [p for p, stage in samples if stage.startswith("analogy")]
+    assert analogy and min(analogy) >= 0.3 and max(analogy) <= 0.97
+
+
 # ---- bad input -------------------------------------------------------------------
 def run_expecting_error(match, preset="SPIKES", **settings):
     before = scene_state()

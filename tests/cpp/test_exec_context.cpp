@@ -35,6 +35,20 @@ TEST(ExecContext, StageProgressMapsOntoItsRange) {
   EXPECT_DOUBLE_EQ(ctx.progress(), 1.0);  // clamped
 }
 
+TEST(ExecContext, ASpanGivesOneCallItsShareOfTheBar) {
+  ExecContext ctx;
+  ctx.set_span(0.2, 0.6);
+  EXPECT_DOUBLE_EQ(ctx.progress(), 0.2);
+  StageProgress p(&ctx, "inside", 0.0, 1.0, 2);  // a call that knows nothing of the span
+  p.advance(1);
+  EXPECT_DOUBLE_EQ(ctx.progress(), 0.4);
+  ctx.set_progress(1.0);
+  EXPECT_DOUBLE_EQ(ctx.progress(), 0.6);
+  ctx.set_span(0.9, 0.1);  // hi < lo: an empty span at lo
+  ctx.set_progress(0.5);
+  EXPECT_DOUBLE_EQ(ctx.progress(), 0.9);
+}
+
 TEST(ParallelChunks, CoversEveryIndexOnceAndStopsWhenCancelled) {
   ExecContext ctx;
   StageProgress p(&ctx, "loop", 0, 1, 1000);

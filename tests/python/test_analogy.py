@@ -164,3 +164,12 @@ def test_volume_frames_reject_bad_input():
         _native.volume_frames(sdf, [0, 0, 0], 1.0, np.zeros((3, 2)), np.zeros((3, 3)))
     with pytest.raises(_native.InvalidInputError, match="no voxels within"):
         _native.volume_frames(sdf * 10, [0, 0, 0], 1.0, np.zeros((3, 3)), np.ones((3, 3)))
+
+
+def test_a_span_gives_each_call_its_share_of_one_progress_bar(bunny):
+    verts, faces = bunny
+    ctx = _native.ExecContext()
+    ctx.set_span(0.5, 0.75)
+    assert ctx.progress == 0.5
+    _native.voxelize(verts, faces, resolution=16, ctx=ctx)
+    assert ctx.progress == pytest.approx(0.75)  # the call's 100 % is the span's end

@@ -87,14 +87,18 @@ class FieldSpec:
             tuple(float(a) for a in self.axis), "({:g}, {:g}, {:g})".format(*self.axis))
         return f"{self.preset.replace('_', ' ')} {axis}"
 
-    def frames_t(self, mesh, grid, ctx):
-        """The (Z, Y, X, 3) field T on `grid` (a voxelize result of `mesh`)."""
+    def frames_t(self, mesh, grid, ctx, span=(0.0, 1.0)):
+        """The (Z, Y, X, 3) field T on `grid` (a voxelize result of `mesh`),
+        reporting progress within `span` of the job's bar."""
+        lo, hi = span
         if self.vectors is not None:
             points, vectors = self.points, self.vectors
         else:
+            Job.share(ctx, lo, 0.5 * (lo + hi))
             points = mesh.vertices
             vectors = _native.preset_direction_field(
                 mesh.vertices, mesh.triangles, self.preset, axis=self.axis, curve=self.curve, ctx=ctx)
+        Job.share(ctx, 0.5 * (lo + hi), hi)
         return _native.volume_frames(grid["sdf"], grid["origin"], float(grid["voxel_size"]),
                                      points, vectors, ctx=ctx)["t"]
 
@@ -170,10 +174,12 @@ class GeometricTextureJob(Job):
         else:
             padding = self.padding()
             region = None
+        self.share(ctx, 0.15, 0.22)
         grid = _native.voxelize(self.b.vertices, self.b.triangles, voxel_size=h, padding=padding, **common)
         b, origin = grid["sdf"], grid["origin"]
-        field_b = self.b.field.frames_t(self.b, grid, ctx)
+        field_b = self.b.field.frames_t(self.b, grid, ctx, span=(0.22, 0.27))
         if not self.user_pair:
+            self.share(ctx, 0.27, 0.3)
             pair = _native.make_exemplar_pair(
                 self.preset, resolution=self.pair_resolution, seed=self.seed, ctx=ctx,
                 memory_budget=self.memory_budget, **self.pair_options,
@@ -189,11 +195,13 @@ class GeometricTextureJob(Job):
             # back times k. The field is a direction: no rescaling.
             h_a = float(pair["voxel_size"])  # 2 / pair resolution
             scale = h / h_a
+        self.share(ctx, 0.3, 0.97)
         res = _native.synthesize_analogy(
             a, a_prime, np.ascontiguousarray(b / scale, np.float32), field_a=field_a, field_b=field_b,
             voxel_size=h_a, a_region=region, memory_budget=self.memory_budget, seed=self.seed, ctx=ctx,
         )
         b_prime = np.ascontiguousarray(res["b_prime"] * scale, np.float32)
+        self.share(ctx, 0.97, 1.0)
         surface = _native.isosurface(b_prime, origin, h, isovalue=0.0, ctx=ctx)
         if len(surface[1]) == 0:
             fix = ("Pick an A′ that is A with a local change (bumps, grooves) at the size of the features "
@@ -220,7 +228,8 @@ class GeometricTextureJob(Job):
         corners = np.array([np.minimum(self.a.vertices.min(0), self.a_prime.vertices.min(0)),
                             np.maximum(self.a.vertices.max(0), self.a_prime.vertices.max(0))])
         grids = []
-        for mesh in (self.a, self.a_prime):
+        for k, mesh in enumerate((self.a, self.a_prime)):
+            self.share(ctx, 0.04 * k, 0.04 * (k + 1))
             verts = np.concatenate([np.asarray(mesh.vertices, np.float64), corners])
             grids.append(_native.voxelize(verts, mesh.triangles, voxel_size=h,
                                           padding=NEIGHBOURHOOD_PADDING + 1, **common))
@@ -233,13 +242,14 @@ class GeometricTextureJob(Job):
             )
         outside = a_prime < 0
         growth = max(0.0, float(a[outside].max())) if outside.any() else 0.0
-        field_a = self.a.field.frames_t(self.a, grids[0], ctx)
+        field_a = self.a.field.frames_t(self.a, grids[0], ctx, span=(0.08, 0.12))
         region = None
         if self.a.region is not None:
             # Distance to the selected faces on the same grid (an open
             # surface: the voxelizer's distance is unsigned there); A' may
             # reach as far as its growth from them.
             verts, tris = self.a.region
+            self.share(ctx, 0.12, 0.15)
             near = _native.voxelize(np.concatenate([np.asarray(verts, np.float64), corners]), tris,
                                     voxel_size=h, padding=NEIGHBOURHOOD_PADDING + 1, **common)["sdf"]
             if near.shape != a.shape:

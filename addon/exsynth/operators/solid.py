@@ -50,10 +50,13 @@ class Baked:
     colors: np.ndarray = None   # ATTRIBUTE: (L, C), one per face corner
 
 
-def bake_targets(volume, origin, voxel_size, targets, options, ctx):
-    """Bake a tiling volume onto each target (worker thread: no bpy)."""
+def bake_targets(volume, origin, voxel_size, targets, options, ctx, span=(0.0, 1.0)):
+    """Bake a tiling volume onto each target (worker thread: no bpy),
+    reporting progress within `span` of the job's bar."""
     baked = []
-    for target in targets:
+    lo, hi = span
+    for k, target in enumerate(targets):
+        Job.share(ctx, lo + (hi - lo) * k / len(targets), lo + (hi - lo) * (k + 1) / len(targets))
         if ctx is not None and ctx.cancelled:
             raise _native.CancelledError("cancelled")
         if target.mode == bake_io.IMAGE:
@@ -155,13 +158,15 @@ class SolidJob(Job):
     label = "solid texture"
 
     def run(self, ctx):
+        self.share(ctx, 0.0, 0.9 if self.targets else 1.0)
         res = _native.synthesize_solid(
             self.exemplar, exemplar_y=self.exemplar_y, exemplar_z=self.exemplar_z, size=self.size,
             levels=self.levels, iterations=self.iterations, seed=self.seed,
             memory_budget=self.memory_budget, ctx=ctx,
         )
         solid = Solid(res["solid"], self.scale / self.size, list(res["energy"]))
-        baked = bake_targets(solid.values, solid.origin, solid.voxel_size, self.targets, self.bake, ctx)
+        baked = bake_targets(solid.values, solid.origin, solid.voxel_size, self.targets, self.bake, ctx,
+                             span=(0.9, 1.0))
         return SolidResult(self.name, solid, baked, np.asarray(self.anchor, np.float64), self.encoding)
 
 

@@ -47,6 +47,7 @@ class VoxelizeJob(Job):
     label = "voxelize"
 
     def run(self, ctx):
+        self.share(ctx, 0.0, 0.85 if self.make_mesh else 1.0)
         grids = _native.voxelize(
             self.vertices, self.triangles,
             resolution=self.resolution, voxel_size=self.voxel_size, padding=self.padding,
@@ -56,6 +57,7 @@ class VoxelizeJob(Job):
         voxels = Voxels(self.name, grids["density"], grids["sdf"], grids["origin"], grids["voxel_size"])
         if self.make_mesh:
             # The sdf is positive outside, so the isosurface's normals face out.
+            self.share(ctx, 0.85, 1.0)
             voxels.surface = _native.isosurface(
                 voxels.sdf, voxels.origin, voxels.voxel_size, isovalue=0.0, ctx=ctx
             )

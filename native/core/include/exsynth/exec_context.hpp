@@ -20,8 +20,22 @@ class ExecContext {
     if (cancelled()) throw Cancelled("cancelled by the user");
   }
 
+  /// Progress p in [0, 1] of the current call, shown as lo + p (hi - lo)
+  /// of the whole job (see set_span).
   void set_progress(double p) {
-    progress_.store(p < 0 ? 0 : (p > 1 ? 1 : p), std::memory_order_relaxed);
+    p = p < 0 ? 0 : (p > 1 ? 1 : p);
+    const double lo = span_lo_.load(std::memory_order_relaxed), hi = span_hi_.load(std::memory_order_relaxed);
+    progress_.store(lo + p * (hi - lo), std::memory_order_relaxed);
+  }
+  /// A job made of several calls gives each its share of one progress bar:
+  /// set_span(0.2, 0.9) before a call makes that call's 0..1 read 0.2..0.9.
+  /// Set it between calls, not while one runs. Default: [0, 1].
+  void set_span(double lo, double hi) {
+    lo = lo < 0 ? 0 : (lo > 1 ? 1 : lo);
+    hi = hi < lo ? lo : (hi > 1 ? 1 : hi);
+    span_lo_.store(lo, std::memory_order_relaxed);
+    span_hi_.store(hi, std::memory_order_relaxed);
+    progress_.store(lo, std::memory_order_relaxed);
   }
   double progress() const { return progress_.load(std::memory_order_relaxed); }
 
@@ -37,6 +51,7 @@ class ExecContext {
  private:
   std::atomic<bool> cancelled_{false};
   std::atomic<double> progress_{0.0};
+  std::atomic<double> span_lo_{0.0}, span_hi_{1.0};
   mutable std::mutex mutex_;
   std::string stage_;
 };
