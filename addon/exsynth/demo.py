@@ -148,10 +148,10 @@ def run_solid(cow_path, exemplar_path, out_dir, size=64, samples=16):
     return 0
 
 
-def run_analogy(bunny_path, out_dir, resolution=96, pattern_size=0.5, samples=16):
-    """The bunny beside two Geometric Texture results of the real operator:
-    spikes, and grooves following a field around the world Z axis (the
-    panel's default field preset)."""
+def run_analogy(bunny_path, out_dir, resolution=128, pattern_size=0.4, samples=16):
+    """The bunny beside two Geometric Texture results of the real operators:
+    a direction field diffused from two painted strokes (Direction Field),
+    then spikes and grooves following it (Geometric Texture)."""
     t0 = time.perf_counter()
     bpy.ops.wm.read_homefile(use_empty=True)
     _ensure_addon()
@@ -168,10 +168,13 @@ def run_analogy(bunny_path, out_dir, resolution=96, pattern_size=0.5, samples=16
     bunny.data.materials.append(materials.new_surface_material("Demo Original", (0.55, 0.58, 0.62)))
 
     settings = scene.exsynth
+    _paint_strokes(bunny)
+    settings.field_mode = 'DIFFUSE'
+    _select([bunny])
+    if bpy.ops.exsynth.direction_field() != {'FINISHED'}:
+        raise RuntimeError("exsynth.direction_field did not finish")
     settings.geo_resolution = resolution
     settings.geo_pattern_scale = pattern_size
-    settings.geo_field_preset = 'AROUND_AXIS'
-    settings.geo_field_axis = 'Z'
     made, seconds = [], []
     for preset, rgb in (('SPIKES', (0.72, 0.42, 0.22)), ('GROOVES', (0.25, 0.45, 0.70))):
         settings.geo_preset = preset
@@ -203,6 +206,24 @@ def run_analogy(bunny_path, out_dir, resolution=96, pattern_size=0.5, samples=16
           f"{seconds[0]:.2f} s, grooves {seconds[1]:.2f} s; render {t2 - t1:.1f} s; total {t2 - t0:.1f} s "
           f"-> {out_dir}")
     return 0
+
+
+def _paint_strokes(bunny):
+    """Two painted strokes on the flank the camera sees, as an artist would
+    paint them in the `exsynth_paint` attribute: upright over the front
+    half, lengthwise over the rear; the rest is left free (zero) for the
+    Direction Field operator to fill in by diffusion."""
+    mesh = bunny.data
+    co = np.zeros(3 * len(mesh.vertices), np.float32)
+    mesh.vertices.foreach_get("co", co)
+    co = co.reshape(-1, 3)  # local: the OBJ's axes (y up; +z towards the camera; head at -x)
+    u = (co - co.min(axis=0)) / np.ptp(co, axis=0)
+    paint = np.zeros_like(co)
+    flank = u[:, 2] > 0.6
+    paint[flank & (u[:, 0] < 0.45)] = (0.0, 1.0, 0.0)
+    paint[flank & (u[:, 0] > 0.6)] = (1.0, 0.0, 0.0)
+    attribute = mesh.attributes.new("exsynth_paint", 'FLOAT_VECTOR', 'POINT')
+    attribute.data.foreach_set("vector", paint.ravel())
 
 
 def _world_bounds(obj):
