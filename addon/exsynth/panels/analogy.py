@@ -5,19 +5,7 @@ import bpy
 
 from ..operators.analogy import PAIR_MAX, PAIR_MIN, pair_resolution
 from ..operators.field import FIELD_ATTRIBUTE
-from .main import CATEGORY
-
-
-class _Panel:
-    bl_space_type = 'VIEW_3D'
-    bl_region_type = 'UI'
-    bl_category = CATEGORY
-
-    def _layout(self):
-        layout = self.layout
-        layout.use_property_split = True
-        layout.use_property_decorate = False
-        return layout
+from .main import SidebarPanel, draw_shared_advanced
 
 
 def _is_mesh(obj):
@@ -28,7 +16,7 @@ def _has_field(obj):
     return _is_mesh(obj) and obj.data.attributes.get(FIELD_ATTRIBUTE) is not None
 
 
-class EXSYNTH_PT_geometric_texture(_Panel, bpy.types.Panel):
+class EXSYNTH_PT_geometric_texture(SidebarPanel, bpy.types.Panel):
     bl_label = "Geometric Texture"
 
     def draw(self, context):
@@ -84,17 +72,13 @@ class EXSYNTH_PT_geometric_texture(_Panel, bpy.types.Panel):
         row.operator("exsynth.geometric_texture", icon='MOD_DISPLACE')
 
 
-class EXSYNTH_PT_geometric_texture_advanced(_Panel, bpy.types.Panel):
+class EXSYNTH_PT_geometric_texture_advanced(SidebarPanel, bpy.types.Panel):
     bl_label = "Advanced"
     bl_parent_id = "EXSYNTH_PT_geometric_texture"
     bl_options = {'DEFAULT_CLOSED'}
 
     def draw(self, context):
-        layout = self._layout()
-        settings = context.scene.exsynth
-        layout.prop(settings, "seed")
-        layout.prop(settings, "memory_budget_gib", text="Memory Budget (GiB)")
-        layout.label(text="Shared with Voxelize", icon='LINKED')
+        draw_shared_advanced(self._layout(), context.scene.exsynth)
 
 
 CLASSES = (EXSYNTH_PT_geometric_texture, EXSYNTH_PT_geometric_texture_advanced)

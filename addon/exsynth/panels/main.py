@@ -8,6 +8,27 @@ import bpy
 CATEGORY = "ExSynth"
 
 
+class SidebarPanel:
+    """Base of the tool panels in the ExSynth tab (property-split layout)."""
+
+    bl_space_type = 'VIEW_3D'
+    bl_region_type = 'UI'
+    bl_category = CATEGORY
+
+    def _layout(self):
+        layout = self.layout
+        layout.use_property_split = True
+        layout.use_property_decorate = False
+        return layout
+
+
+def draw_shared_advanced(layout, settings):
+    """Seed and memory budget: scene-wide settings every tool's Advanced panel shows."""
+    layout.prop(settings, "seed")
+    layout.prop(settings, "memory_budget_gib", text="Memory Budget (GiB)")
+    layout.label(text="Shared with Voxelize", icon='LINKED')
+
+
 class EXSYNTH_PT_voxelize(bpy.types.Panel):
     bl_label = "Voxelize"
     bl_space_type = 'VIEW_3D'

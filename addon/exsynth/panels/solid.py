@@ -3,22 +3,10 @@
 
 import bpy
 
-from .main import CATEGORY
+from .main import SidebarPanel, draw_shared_advanced
 
 
-class _Panel:
-    bl_space_type = 'VIEW_3D'
-    bl_region_type = 'UI'
-    bl_category = CATEGORY
-
-    def _layout(self):
-        layout = self.layout
-        layout.use_property_split = True
-        layout.use_property_decorate = False
-        return layout
-
-
-class EXSYNTH_PT_solid(_Panel, bpy.types.Panel):
+class EXSYNTH_PT_solid(SidebarPanel, bpy.types.Panel):
     bl_label = "Solid Texture"
 
     def draw(self, context):
@@ -58,7 +46,7 @@ class EXSYNTH_PT_solid(_Panel, bpy.types.Panel):
         row.operator("exsynth.solid_texture", icon='TEXTURE')
 
 
-class EXSYNTH_PT_solid_axes(_Panel, bpy.types.Panel):
+class EXSYNTH_PT_solid_axes(SidebarPanel, bpy.types.Panel):
     bl_label = "Per-Axis Exemplars"
     bl_parent_id = "EXSYNTH_PT_solid"
     bl_options = {'DEFAULT_CLOSED'}
@@ -71,7 +59,7 @@ class EXSYNTH_PT_solid_axes(_Panel, bpy.types.Panel):
         layout.prop(settings, "solid_exemplar_z", text="Z (XY slices)")
 
 
-class EXSYNTH_PT_solid_rebake(_Panel, bpy.types.Panel):
+class EXSYNTH_PT_solid_rebake(SidebarPanel, bpy.types.Panel):
     bl_label = "Re-bake"
     bl_parent_id = "EXSYNTH_PT_solid"
 
@@ -82,17 +70,13 @@ class EXSYNTH_PT_solid_rebake(_Panel, bpy.types.Panel):
         layout.operator("exsynth.solid_rebake", icon='FILE_REFRESH')
 
 
-class EXSYNTH_PT_solid_advanced(_Panel, bpy.types.Panel):
+class EXSYNTH_PT_solid_advanced(SidebarPanel, bpy.types.Panel):
     bl_label = "Advanced"
     bl_parent_id = "EXSYNTH_PT_solid"
     bl_options = {'DEFAULT_CLOSED'}
 
     def draw(self, context):
-        layout = self._layout()
-        settings = context.scene.exsynth
-        layout.prop(settings, "seed")
-        layout.prop(settings, "memory_budget_gib", text="Memory Budget (GiB)")
-        layout.label(text="Shared with Voxelize", icon='LINKED')
+        draw_shared_advanced(self._layout(), context.scene.exsynth)
 
 
 CLASSES = (EXSYNTH_PT_solid, EXSYNTH_PT_solid_axes, EXSYNTH_PT_solid_rebake, EXSYNTH_PT_solid_advanced)

@@ -10,24 +10,9 @@
 #include "exsynth/parallel.hpp"
 #include "exsynth/sample.hpp"
 #include "field/tangent.hpp"
+#include "grid/gradient.hpp"
 
 namespace exsynth::analogy {
-namespace {
-
-Eigen::Vector3f gradient(const Volume& v, int x, int y, int z) {
-  const int p[3] = {x, y, z}, dims[3] = {v.nx(), v.ny(), v.nz()};
-  Eigen::Vector3f g;
-  for (int a = 0; a < 3; ++a) {
-    int lo[3] = {x, y, z}, hi[3] = {x, y, z};
-    lo[a] = std::max(0, p[a] - 1);
-    hi[a] = std::min(dims[a] - 1, p[a] + 1);
-    const int span = hi[a] - lo[a];  // 2 inside, 1 on the border (one-sided)
-    g[a] = span ? (v.at(hi[0], hi[1], hi[2]) - v.at(lo[0], lo[1], lo[2])) / float(span) : 0.0f;
-  }
-  return g;
-}
-
-}  // namespace
 
 std::vector<Frame> frames_at(const Volume& sdf, const Volume& field, int scale,
                              const std::vector<std::uint32_t>& voxels, std::size_t* bad_count) {
@@ -44,8 +29,7 @@ std::vector<Frame> frames_at(const Volume& sdf, const Volume& field, int scale,
       const std::uint32_t v = voxels[i];
       const int x = int(v % std::uint32_t(nx)), y = int((v / std::uint32_t(nx)) % std::uint32_t(ny)),
                 z = int(v / (std::uint32_t(nx) * std::uint32_t(ny)));
-      Eigen::Vector3f n = gradient(sdf, x, y, z);
-      n = n.norm() > 1e-12f ? Eigen::Vector3f(n.normalized()) : Eigen::Vector3f::UnitZ();
+      const Eigen::Vector3f n = grid::unit_normal(sdf, x, y, z);
       float t[3];
       sample_trilinear(field, double(x) * scale, double(y) * scale, double(z) * scale, t);
       Eigen::Vector3f tv(t[0], t[1], t[2]);

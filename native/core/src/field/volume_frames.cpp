@@ -9,6 +9,7 @@
 
 #include "exsynth/errors.hpp"
 #include "exsynth/parallel.hpp"
+#include "grid/gradient.hpp"
 #include "search/pca.hpp"
 #include "voxel/distance_transform.hpp"
 
@@ -65,18 +66,7 @@ VolumeFrames volume_frames(const Volume& sdf, const std::vector<Eigen::Vector3f>
   parallel_chunks(std::size_t(nz), 1, normals, [&](std::size_t z0, std::size_t z1) {
     for (int z = int(z0); z < int(z1); ++z)
       for (int y = 0; y < ny; ++y)
-        for (int x = 0; x < nx; ++x) {
-          const int p[3] = {x, y, z}, dims[3] = {nx, ny, nz};
-          Eigen::Vector3f g;
-          for (int a = 0; a < 3; ++a) {
-            int lo[3] = {x, y, z}, hi[3] = {x, y, z};
-            lo[a] = std::max(0, p[a] - 1);
-            hi[a] = std::min(dims[a] - 1, p[a] + 1);
-            const int span = hi[a] - lo[a];  // 2 inside, 1 on the border (one-sided)
-            g[a] = span ? (sdf.at(hi[0], hi[1], hi[2]) - sdf.at(lo[0], lo[1], lo[2])) / float(span) : 0.0f;
-          }
-          set3(f.n, index(x, y, z), g.norm() > 1e-12f ? Eigen::Vector3f(g.normalized()) : Eigen::Vector3f::UnitZ());
-        }
+        for (int x = 0; x < nx; ++x) set3(f.n, index(x, y, z), grid::unit_normal(sdf, x, y, z));
   });
 
   // Surface voxels take the field of their nearest field point.
