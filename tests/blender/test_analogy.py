@@ -103,10 +103,10 @@ def test_spikes_from_the_field_preset_add_surface(bunny, capfd):
     for word in ("field around axis Z", "searched", "coherent", "culled", "debris"):
         assert word in report
     # Spikes stand out of the surface: more area than B's own voxel surface
-    # at the same resolution (measured +12.2 %).
+    # at the same resolution (measured +24 %).
     r_verts, r_tris = world_mesh(obj)
     own = own_isosurface(verts, tris, 64)
-    assert surface_area(r_verts, r_tris) > 1.06 * surface_area(*own)
+    assert surface_area(r_verts, r_tris) > 1.12 * surface_area(*own)
 
 
 @pytest.mark.parametrize("source", ["preset around Z", "attribute along Z", "curve around Z"])
@@ -116,7 +116,7 @@ def test_grooves_follow_the_field(bunny, source):
     # an `exsynth_field` along Z on the mesh wins over that preset and turns
     # them vertical; a horizontal circle (a curve object, moved and scaled)
     # around the bunny gives rings again. Measured ratios at 64 voxels:
-    # 1.51-1.59, 0.82-0.85 and 1.59 (two engine builds).
+    # 1.99, 0.63 and 1.90.
     verts, tris = world_mesh(bunny)
     settings = dict(geo_field_preset='AROUND_AXIS', geo_field_axis='Z')
     if source == "attribute along Z":
@@ -132,9 +132,9 @@ def test_grooves_follow_the_field(bunny, source):
     assert texture("GROOVES", resolution=64, geo_make_volume=True, **settings) == {'FINISHED'}
     ratio = groove_ratio(verts, tris, *b_prime_grid("bunny_grooves_volume"))
     if source == "attribute along Z":
-        assert ratio < 1.1
+        assert ratio < 0.9
     else:
-        assert ratio > 1.25
+        assert ratio > 1.5
 
 
 def pits_b_prime(axis, attribute=None):
@@ -463,8 +463,8 @@ def test_cli_spikes_obj(tmp_path, capsys):
     assert "analogy: spikes on bunny.obj" in line and "field around axis Y" in line and "searched" in line
     verts, faces = read_obj(out)
     own = own_isosurface(*read_obj(BUNNY_OBJ), 64)
-    # Measured: area +12.6 %, volume -4.3 % (thin parts such as the ears lose some).
-    assert surface_area(verts, faces) > 1.05 * surface_area(*own)
+    # Measured: area +25 %, volume +6.7 %.
+    assert surface_area(verts, faces) > 1.12 * surface_area(*own)
     assert 0.85 < enclosed_volume(verts, faces) / enclosed_volume(*own) < 1.15
 
 
@@ -476,9 +476,8 @@ def test_cli_grooves_npy_run_around_the_axis(tmp_path):
     assert b_prime.dtype == np.float32 and b_prime.ndim == 3
     verts, faces = read_obj(BUNNY_OBJ)
     h = float((verts.astype(np.float32).max(0) - verts.astype(np.float32).min(0)).max()) / 64
-    assert groove_ratio(verts, faces, b_prime, None, h, axis=(0, 1, 0)) > 1.25
-    # Grooves carve: less inside than B (measured -18 %), but still the bunny.
-    # (groove ratio measured 1.53)
+    assert groove_ratio(verts, faces, b_prime, None, h, axis=(0, 1, 0)) > 1.5  # measured 1.97
+    # Grooves carve: less inside than B (measured -13 %), but still the bunny.
     b = _native.voxelize(verts, faces, voxel_size=h, padding=4)["sdf"]
     assert b.shape == b_prime.shape
     assert 0.7 < (b_prime < 0).sum() / (b < 0).sum() < 1.0

@@ -165,6 +165,37 @@ std::vector<unsigned char> change_mask(const Volume& a, const Volume& ap, float 
   return m;
 }
 
+// Band positions in breadth-first order over 26-neighbours within the band,
+// each piece started from its first position in `order`.
+std::vector<std::uint32_t> breadth_first(const Volume& grid, const std::vector<std::uint32_t>& band,
+                                         const std::vector<std::int32_t>& band_of,
+                                         const std::vector<std::uint32_t>& order) {
+  std::vector<std::uint32_t> out;
+  out.reserve(band.size());
+  std::vector<unsigned char> seen(band.size(), 0);
+  for (const std::uint32_t start : order) {
+    if (seen[start]) continue;
+    seen[start] = 1;
+    std::size_t head = out.size();
+    out.push_back(start);
+    while (head < out.size()) {
+      const Vec3 g = voxel_position(grid, band[out[head++]]);
+      const int x = int(g.x()), y = int(g.y()), z = int(g.z());
+      for (int dz = -1; dz <= 1; ++dz)
+        for (int dy = -1; dy <= 1; ++dy)
+          for (int dx = -1; dx <= 1; ++dx) {
+            const int qx = x + dx, qy = y + dy, qz = z + dz;
+            if (qx < 0 || qy < 0 || qz < 0 || qx >= grid.nx() || qy >= grid.ny() || qz >= grid.nz()) continue;
+            const std::int32_t q = band_of[grid.voxel_index(qx, qy, qz)];
+            if (q < 0 || seen[std::size_t(q)]) continue;
+            seen[std::size_t(q)] = 1;
+            out.push_back(std::uint32_t(q));
+          }
+    }
+  }
+  return out;
+}
+
 Volume upsample(const Volume& coarse, const Volume& like) {
   Volume out(like.nx(), like.ny(), like.nz(), 1, 0.0f, like.transform());
   StageProgress quiet(nullptr, {}, 0.0, 0.0, std::size_t(like.nz()));
@@ -238,6 +269,10 @@ AnalogyResult run(const Volume& a, const Volume& a_prime, const Volume* field_a,
   const Reach reach = pair_reach(a, a_prime);
   AnalogyResult result;
   Volume bp_coarse, phi_coarse, has_phi_coarse;
+  // The coarser level's sources (positions in its A, per voxel of its grid;
+  // NaN where it had none): the finer level starts from them, so its first
+  // sweep continues the coarse copy instead of starting copies of its own.
+  std::vector<Vec3> coarse_source_at;
   double work_total = 0, work_done = 0;
   for (const Volume& v : pb) work_total += double(v.voxel_count());
   for (int l = 0; l < L; ++l) {
@@ -368,21 +403,62 @@ AnalogyResult run(const Volume& a, const Volume& a_prime, const Volume* field_a,
     std::vector<std::int32_t> source(band.size(), -1);
     std::vector<Vec3> source_at(band.size());
     const int nx = bl.nx(), ny = bl.ny(), nz = bl.nz();
+    if (has_coarser && opt.coherence > 0) {
+      // Each voxel's coarse parent (its index / 2) copied from c in the
+      // coarse A: this voxel's offset from the parent's centre, carried into
+      // A's frame, lands at 2 c + that offset in this level's A.
+      const Volume& coarse_grid = pb[std::size_t(k + 1)];
+      for (std::size_t i = 0; i < band.size(); ++i) {
+        const Vec3 g = voxel_position(bl, band[i]);
+        const int px = std::min(int(g.x()) / 2, coarse_grid.nx() - 1), py = std::min(int(g.y()) / 2, coarse_grid.ny() - 1),
+                  pz = std::min(int(g.z()) / 2, coarse_grid.nz() - 1);
+        const Vec3 parent = coarse_source_at[coarse_grid.voxel_index(px, py, pz)];
+        if (!parent.allFinite()) continue;
+        const Vec3 centre = 2.0f * parent;
+        const int cx = int(std::lround(centre.x())), cy = int(std::lround(centre.y())), cz = int(std::lround(centre.z()));
+        if (cx < 0 || cy < 0 || cz < 0 || cx >= al.nx() || cy >= al.ny() || cz >= al.nz()) continue;
+        const std::int32_t r0 = row_of[al.voxel_index(cx, cy, cz)];
+        if (r0 < 0) continue;
+        const Vec3 c = centre + a_frames[std::size_t(r0)] * (b_frames[i].transpose() * (g - 2.0f * Vec3(float(px), float(py), float(pz))));
+        const int ax = int(std::lround(c.x())), ay = int(std::lround(c.y())), az = int(std::lround(c.z()));
+        if (ax < 0 || ay < 0 || az < 0 || ax >= al.nx() || ay >= al.ny() || az >= al.nz()) continue;
+        const std::int32_t r = row_of[al.voxel_index(ax, ay, az)];
+        if (r < 0) continue;
+        source[i] = r;
+        source_at[i] = c;
+      }
+    }
     const float kappa = float((1.0 + opt.coherence) * (1.0 + opt.coherence));
     const float slack = float(opt.coherence_slack * coeffs.squaredNorm() / double(coeffs.rows()));
-    StageProgress synth(ctx, stage + " synthesis", p0 + 0.2 * (p1 - p0), p1, std::size_t(opt.sweeps) * band.size());
+    // At the coarsest level a growing pass comes first (sweep -1): B' = B
+    // would make every causal neighbourhood pattern-free, so the first
+    // choices would all be pattern-free places of A' and, along the field,
+    // stay so. Instead each voxel takes the position its visited neighbours
+    // agree on, whatever it looks like (the nearest neighbour only where
+    // there is none): one coherent copy of A', pattern and all, that the
+    // sweeps then correct where it does not fit B.
+    const bool grow = !has_coarser && opt.coherence > 0;
+    // The growing pass floods the band breadth-first from the first voxel
+    // in sweep order (then from the first not yet reached, for each further
+    // piece): every voxel but a piece's first has a visited neighbour. (The
+    // sweep order itself has a local minimum wherever the field circles, and
+    // every minimum would start a copy of its own.)
+    std::vector<std::uint32_t> grow_order;
+    if (grow) grow_order = breadth_first(bl, band, band_of, order);
+    StageProgress synth(ctx, stage + " synthesis", p0 + 0.2 * (p1 - p0), p1,
+                        std::size_t(opt.sweeps + (grow ? 1 : 0)) * band.size());
     Eigen::RowVectorXf fc(C), y(d);
     std::vector<std::int32_t> tried;
     std::vector<int> votes;
     std::vector<Vec3> sums;
     std::vector<float> cand_dists;
-    for (int sweep = 0; sweep < opt.sweeps; ++sweep)
+    for (int sweep = grow ? -1 : 0; sweep < opt.sweeps; ++sweep)
       for (std::size_t n = 0; n < order.size(); ++n) {
         if ((n & 1023) == 0) {
           synth.check();
           if (n) synth.advance(1024);
         }
-        const std::uint32_t i = order[n], v = band[i];
+        const std::uint32_t i = (sweep < 0 ? grow_order : order)[n], v = band[i];
         const Vec3 g = voxel_position(bl, v);
         const Frame& f = b_frames[i];
         causal_features(b_side, hood, g, f, fc.data());
@@ -406,22 +482,30 @@ AnalogyResult run(const Volume& a, const Volume& a_prime, const Volume* field_a,
               const std::int32_t q = band_of[bl.voxel_index(qx, qy, qz)];
               if (q < 0 || source[std::size_t(q)] < 0) continue;
               const std::int32_t s = source[std::size_t(q)];
-              const Vec3 local = f.transpose() * Vec3(float(-dx), float(-dy), float(-dz));
+              // The offset in the neighbour's own frame: a source that is A rotated onto
+              // B stays exactly so (with the centre's frame it would drift).
+              const Vec3 local = b_frames[std::size_t(q)].transpose() * Vec3(float(-dx), float(-dy), float(-dz));
               const Vec3 c = source_at[std::size_t(q)] + a_frames[std::size_t(s)] * local;
-              const int cx = int(std::lround(c.x())), cy = int(std::lround(c.y())), cz = int(std::lround(c.z()));
-              if (cx < 0 || cy < 0 || cz < 0 || cx >= al.nx() || cy >= al.ny() || cz >= al.nz()) continue;
-              const std::int32_t r = row_of[al.voxel_index(cx, cy, cz)];
-              if (r < 0) continue;
-              const auto it = std::find(tried.begin(), tried.end(), r);
-              if (it != tried.end()) {
-                ++votes[std::size_t(it - tried.begin())];
-                sums[std::size_t(it - tried.begin())] += c;
+              // Neighbours of one patch propose (nearly) the same position:
+              // they vote together even when rounding would split them.
+              std::size_t k = 0;
+              while (k < sums.size() && (sums[k] / float(votes[k]) - c).squaredNorm() > 0.5f) ++k;
+              if (k < sums.size()) {
+                ++votes[k];
+                sums[k] += c;
               } else {
-                tried.push_back(r);
                 votes.push_back(1);
                 sums.push_back(c);
               }
             }
+        // Each proposal's database row: the A voxel nearest its mean position.
+        tried.resize(sums.size());
+        for (std::size_t k = 0; k < sums.size(); ++k) {
+          const Vec3 c = sums[k] / float(votes[k]);
+          const int cx = int(std::lround(c.x())), cy = int(std::lround(c.y())), cz = int(std::lround(c.z()));
+          const bool inside = cx >= 0 && cy >= 0 && cz >= 0 && cx < al.nx() && cy < al.ny() && cz < al.nz();
+          tried[k] = inside ? row_of[al.voxel_index(cx, cy, cz)] : -1;
+        }
         // The candidate most neighbours agree on (then the closest). If it is
         // within the slack, the rule below would take it whatever the
         // nearest neighbour's distance (>= 0): skip the k-d tree query.
@@ -429,13 +513,17 @@ AnalogyResult run(const Volume& a, const Volume& a_prime, const Volume* field_a,
         dists.resize(tried.size());
         std::size_t top = tried.size();
         for (std::size_t c = 0; c < tried.size(); ++c) {
+          if (tried[c] < 0) {  // off A's database: no candidate
+            dists[c] = std::numeric_limits<float>::infinity();
+            continue;
+          }
           dists[c] = (coeffs.row(tried[c]) - y).squaredNorm();
           if (top == tried.size() || votes[c] > votes[top] || (votes[c] == votes[top] && dists[c] < dists[top])) top = c;
         }
         std::int32_t best;
         Vec3 at;
         int best_votes = 0;
-        if (top < tried.size() && dists[top] <= slack) {
+        if (top < tried.size() && (sweep < 0 || dists[top] <= slack)) {
           best = tried[top], best_votes = votes[top], at = sums[top] / float(votes[top]);
           ++result.ann_skipped;
         } else {
@@ -456,6 +544,11 @@ AnalogyResult run(const Volume& a, const Volume& a_prime, const Volume* field_a,
         source_at[i] = at;
         ++result.searched;
       }
+    if (l + 1 < L) {
+      coarse_source_at.assign(bl.voxel_count(), Vec3::Constant(std::numeric_limits<float>::quiet_NaN()));
+      for (std::size_t i = 0; i < band.size(); ++i)
+        if (source[i] >= 0) coarse_source_at[band[i]] = source_at[i];
+    }
     bp_coarse = std::move(bp);
   }
   result.b_prime = std::move(bp_coarse);
