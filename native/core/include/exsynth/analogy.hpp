@@ -17,7 +17,9 @@
 // candidate wins unless the nearest neighbour is clearly better. Coherence
 // is what lets a pattern start on a smooth B: B' = B matches the pattern-free
 // parts of A' exactly, but a continued source copies A' as it is, pattern and
-// all.
+// all. So the coarsest level begins with a growing pass (breadth-first, each
+// voxel continuing what its visited neighbours agree on: one coherent copy
+// of A' over B), and each finer level starts from the coarser sources.
 //
 // The isotropic variant (blur, dilation) uses one global frame and scanline
 // order.
