@@ -149,9 +149,10 @@ def run_solid(cow_path, exemplar_path, out_dir, size=64, samples=16):
 
 
 def run_analogy(bunny_path, out_dir, resolution=128, pattern_size=0.4, samples=16):
-    """The bunny beside two Geometric Texture results of the real operators:
-    a direction field diffused from two painted strokes (Direction Field),
-    then spikes and grooves following it (Geometric Texture)."""
+    """Geometric Texture with the real operators: a direction field diffused
+    from two painted strokes (Direction Field), then the built-in pairs
+    following it. analogy_bunny.png: the bunny, with spikes and with
+    grooves; analogy_pairs.png: spikes, pits, holes and grooves."""
     t0 = time.perf_counter()
     bpy.ops.wm.read_homefile(use_empty=True)
     _ensure_addon()
@@ -175,36 +176,51 @@ def run_analogy(bunny_path, out_dir, resolution=128, pattern_size=0.4, samples=1
         raise RuntimeError("exsynth.direction_field did not finish")
     settings.geo_resolution = resolution
     settings.geo_pattern_scale = pattern_size
-    made, seconds = [], []
-    for preset, rgb in (('SPIKES', (0.72, 0.42, 0.22)), ('GROOVES', (0.25, 0.45, 0.70))):
+    made, seconds = {}, {}
+    colours = {'SPIKES': (0.72, 0.42, 0.22), 'PITS': (0.45, 0.62, 0.38), 'HOLES': (0.62, 0.52, 0.70),
+               'GROOVES': (0.25, 0.45, 0.70)}
+    for preset, rgb in colours.items():
         settings.geo_preset = preset
         _select([bunny])
         t = time.perf_counter()
         result = bpy.ops.exsynth.geometric_texture()
         if result != {'FINISHED'}:
             raise RuntimeError(f"exsynth.geometric_texture ({preset.lower()}) returned {result}")
-        seconds.append(time.perf_counter() - t)
+        seconds[preset] = time.perf_counter() - t
         obj = bpy.data.objects[f"Bunny_{preset.lower()}"]
         obj.data.materials[0] = materials.new_surface_material(f"Demo {preset.title()}", rgb, roughness=0.45)
-        made.append(obj)
+        made[preset] = obj
     t1 = time.perf_counter()
 
-    # Left to right: original, spikes, grooves; the results are in world
-    # space where the bunny is, so all three move by the same steps.
+    # The results are in world space where the bunny is: rows of them move
+    # by the same steps. 1: original, spikes, grooves.
     view_layer.update()
     lo, hi = _world_bounds(bunny)
     gap = 1.25 * float(hi[0] - lo[0])
     centre = Vector((0.5 * (lo[0] + hi[0]), 0.5 * (lo[1] + hi[1]), lo[2]))
-    for i, obj in enumerate([bunny] + made):
-        obj.location += Vector(((i - 1) * gap, 0.0, 0.0)) - centre
+    home = {obj.name: obj.location.copy() for obj in [bunny, *made.values()]}
+
+    def row(objects):
+        for obj in [bunny, *made.values()]:
+            obj.hide_render = obj not in objects
+            obj.location = home[obj.name]
+        for i, obj in enumerate(objects):
+            obj.location += Vector(((i - 0.5 * (len(objects) - 1)) * gap, 0.0, 0.0)) - centre
+
     _stage(scene, samples)
+    row([bunny, made['SPIKES'], made['GROOVES']])
     scene.render.resolution_x = 2 * RESOLUTION_PX[1]  # three bunnies side by side: wider
     _aim_camera(scene, Vector((0.0, 0.0, 0.45 * BUNNY_HEIGHT)), distance=11.5, side=0.0)
     _render(scene, os.path.join(out_dir, "analogy_bunny.png"))
+    # 2: the four built-in pattern pairs.
+    row([made[p] for p in ('SPIKES', 'PITS', 'HOLES', 'GROOVES')])
+    scene.render.resolution_x = int(2.6 * RESOLUTION_PX[1])
+    _aim_camera(scene, Vector((0.0, 0.0, 0.45 * BUNNY_HEIGHT)), distance=14.5, side=0.0)
+    _render(scene, os.path.join(out_dir, "analogy_pairs.png"))
     t2 = time.perf_counter()
-    print(f"demo: geometric texture at {resolution} voxels, pattern size {pattern_size}: spikes "
-          f"{seconds[0]:.2f} s, grooves {seconds[1]:.2f} s; render {t2 - t1:.1f} s; total {t2 - t0:.1f} s "
-          f"-> {out_dir}")
+    times = ", ".join(f"{p.lower()} {s:.2f} s" for p, s in seconds.items())
+    print(f"demo: geometric texture at {resolution} voxels, pattern size {pattern_size}: {times}; "
+          f"renders {t2 - t1:.1f} s; total {t2 - t0:.1f} s -> {out_dir}")
     return 0
 
 
