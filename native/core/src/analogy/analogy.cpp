@@ -8,7 +8,10 @@
 #include <vector>
 
 #include "analogy/ann_index.hpp"
+#include "analogy/band.hpp"
 #include "analogy/debris.hpp"
+#include "analogy/exemplar_change.hpp"
+#include "analogy/features.hpp"
 #include "analogy/local_frames.hpp"
 #include "exsynth/errors.hpp"
 #include "exsynth/parallel.hpp"
@@ -18,73 +21,8 @@
 namespace exsynth {
 namespace {
 
-using analogy::Frame;
-using analogy::trilinear;
+using namespace analogy;
 using search::RowMatrixXf;
-using Vec3 = Eigen::Vector3f;
-
-// Neighbourhood offsets in local frame coordinates (T, B, N). The causal
-// part holds the fine cube's offsets that are visited before the centre:
-// the -T half cube in sweep order, or the scanline predecessors (z slowest,
-// then y, then x) in the isotropic variant.
-struct Neighbourhoods {
-  std::vector<Vec3> causal, fine, coarse;
-  int static_dims(bool with_coarse) const { return int(fine.size() + (with_coarse ? 2 * coarse.size() : 0)); }
-  int dims(bool with_coarse) const { return int(causal.size()) + static_dims(with_coarse); }
-};
-
-Neighbourhoods make_neighbourhoods(int fine, int coarse, bool scanline) {
-  Neighbourhoods n;
-  const int r = fine / 2, rc = coarse / 2;
-  for (int k = -r; k <= r; ++k)
-    for (int j = -r; j <= r; ++j)
-      for (int i = -r; i <= r; ++i) {
-        n.fine.emplace_back(float(i), float(j), float(k));
-        const bool before = scanline ? (k < 0 || (k == 0 && (j < 0 || (j == 0 && i < 0)))) : i < 0;
-        if (before) n.causal.emplace_back(float(i), float(j), float(k));
-      }
-  for (int k = -rc; k <= rc; ++k)
-    for (int j = -rc; j <= rc; ++j)
-      for (int i = -rc; i <= rc; ++i) n.coarse.emplace_back(float(i), float(j), float(k));
-  return n;
-}
-
-// One level's view of a side of the analogy: the "before" volume (A or B),
-// the "after" volume (A' or B', being written for B'), and their next-coarser
-// levels (null at the coarsest). Coarse index = fine index / 2: pyramid
-// levels keep voxel 0's centre.
-struct Side {
-  const Volume* before;
-  const Volume* after;
-  const Volume* before_coarse;
-  const Volume* after_coarse;
-};
-
-Vec3 voxel_position(const Volume& v, std::uint32_t i) {
-  const auto nx = std::uint32_t(v.nx()), ny = std::uint32_t(v.ny());
-  return Vec3(float(i % nx), float((i / nx) % ny), float(i / (nx * ny)));
-}
-
-void causal_features(const Side& s, const Neighbourhoods& n, const Vec3& g, const Frame& f, float* out) {
-  for (const Vec3& o : n.causal) {
-    const Vec3 p = g + f * o;
-    *out++ = trilinear(*s.after, p.x(), p.y(), p.z());
-  }
-}
-
-void static_features(const Side& s, const Neighbourhoods& n, const Vec3& g, const Frame& f, float* out) {
-  for (const Vec3& o : n.fine) {
-    const Vec3 p = g + f * o;
-    *out++ = trilinear(*s.before, p.x(), p.y(), p.z());
-  }
-  if (!s.before_coarse) return;
-  const Vec3 gc = 0.5f * g;
-  for (const Volume* v : {s.after_coarse, s.before_coarse})
-    for (const Vec3& o : n.coarse) {
-      const Vec3 p = gc + f * o;
-      *out++ = trilinear(*v, p.x(), p.y(), p.z());
-    }
-}
 
 void check_volume(const Volume& v, const char* name) {
   if (v.empty()) throw InvalidInput(std::string(name) + " is empty; give a volume with at least one voxel");
@@ -121,108 +59,41 @@ void check_field(const Volume& field, const Volume& sdf, const char* name, const
                        "'s surface; give a direction at every surface point (or use a field preset)");
 }
 
-// How far the pair moves A's surface: outward (A' has material where A is
-// empty: spikes) and inward (A' is empty where A had material: pits,
-// grooves), measured at the voxels on either surface.
-struct Reach {
-  double outward = 0, inward = 0;
-};
-Reach pair_reach(const Volume& a, const Volume& ap) {
-  Reach r;
-  const float near = float(a.transform().voxel_size);
-  for (std::size_t i = 0; i < a.voxel_count(); ++i) {
-    const float va = a.data()[i], vp = ap.data()[i];
-    if (std::abs(va) > near && std::abs(vp) > near) continue;
-    r.outward = std::max(r.outward, double(va - vp));
-    r.inward = std::max(r.inward, double(vp - va));
+// Each voxel of this level's band starts from its coarse parent's source
+// (the parent is its index / 2): the parent copied from c in the coarse A,
+// so this voxel's offset from the parent's centre, carried into A's frame,
+// lands at 2 c + that offset in this level's A. Voxels whose parent had no
+// source, or whose position falls off A's database, keep none.
+void carry_coarse_sources(const Volume& coarse_grid, const std::vector<Vec3>& coarse_source_at, const Volume& bl,
+                          const std::vector<std::uint32_t>& band, const std::vector<Frame>& b_frames, const Volume& al,
+                          const std::vector<Frame>& a_frames, const std::vector<std::int32_t>& row_of,
+                          std::vector<std::int32_t>& source, std::vector<Vec3>& source_at) {
+  auto row_near = [&](const Vec3& c) -> std::int32_t {
+    const int x = int(std::lround(c.x())), y = int(std::lround(c.y())), z = int(std::lround(c.z()));
+    if (x < 0 || y < 0 || z < 0 || x >= al.nx() || y >= al.ny() || z >= al.nz()) return -1;
+    return row_of[al.voxel_index(x, y, z)];
+  };
+  for (std::size_t i = 0; i < band.size(); ++i) {
+    const Vec3 g = voxel_position(bl, band[i]);
+    const int px = std::min(int(g.x()) / 2, coarse_grid.nx() - 1), py = std::min(int(g.y()) / 2, coarse_grid.ny() - 1),
+              pz = std::min(int(g.z()) / 2, coarse_grid.nz() - 1);
+    const Vec3 parent = coarse_source_at[coarse_grid.voxel_index(px, py, pz)];
+    if (!parent.allFinite()) continue;
+    const Vec3 centre = 2.0f * parent;
+    const std::int32_t r0 = row_near(centre);
+    if (r0 < 0) continue;
+    const Vec3 c = centre + a_frames[std::size_t(r0)] *
+                                (b_frames[i].transpose() * (g - 2.0f * Vec3(float(px), float(py), float(pz))));
+    const std::int32_t r = row_near(c);
+    if (r < 0) continue;
+    source[i] = r;
+    source_at[i] = c;
   }
-  return r;
 }
 
-// 1 where |A' - A| > tol, dilated by r voxels (a cube).
-std::vector<unsigned char> change_mask(const Volume& a, const Volume& ap, float tol, int r) {
-  const int nx = a.nx(), ny = a.ny(), nz = a.nz();
-  std::vector<unsigned char> m(a.voxel_count()), tmp(a.voxel_count());
-  for (std::size_t i = 0; i < m.size(); ++i) m[i] = std::abs(ap.data()[i] - a.data()[i]) > tol;
-  // Separable max filter, one axis after another.
-  const int dims[3] = {nx, ny, nz};
-  const std::size_t stride[3] = {1, std::size_t(nx), std::size_t(nx) * ny};
-  for (int axis = 0; axis < 3; ++axis) {
-    for (int z = 0; z < nz; ++z)
-      for (int y = 0; y < ny; ++y)
-        for (int x = 0; x < nx; ++x) {
-          const int c[3] = {x, y, z};
-          const std::size_t i = a.voxel_index(x, y, z);
-          unsigned char v = 0;
-          for (int d = -r; d <= r && !v; ++d) {
-            const int q = c[axis] + d;
-            if (q >= 0 && q < dims[axis]) v = m[std::size_t(std::ptrdiff_t(i) + std::ptrdiff_t(d) * std::ptrdiff_t(stride[axis]))];
-          }
-          tmp[i] = v;
-        }
-    m.swap(tmp);
-  }
-  return m;
-}
-
-// Band positions in breadth-first order over 26-neighbours within the band,
-// each piece started from its first position in `order`.
-std::vector<std::uint32_t> breadth_first(const Volume& grid, const std::vector<std::uint32_t>& band,
-                                         const std::vector<std::int32_t>& band_of,
-                                         const std::vector<std::uint32_t>& order) {
-  std::vector<std::uint32_t> out;
-  out.reserve(band.size());
-  std::vector<unsigned char> seen(band.size(), 0);
-  for (const std::uint32_t start : order) {
-    if (seen[start]) continue;
-    seen[start] = 1;
-    std::size_t head = out.size();
-    out.push_back(start);
-    while (head < out.size()) {
-      const Vec3 g = voxel_position(grid, band[out[head++]]);
-      const int x = int(g.x()), y = int(g.y()), z = int(g.z());
-      for (int dz = -1; dz <= 1; ++dz)
-        for (int dy = -1; dy <= 1; ++dy)
-          for (int dx = -1; dx <= 1; ++dx) {
-            const int qx = x + dx, qy = y + dy, qz = z + dz;
-            if (qx < 0 || qy < 0 || qz < 0 || qx >= grid.nx() || qy >= grid.ny() || qz >= grid.nz()) continue;
-            const std::int32_t q = band_of[grid.voxel_index(qx, qy, qz)];
-            if (q < 0 || seen[std::size_t(q)]) continue;
-            seen[std::size_t(q)] = 1;
-            out.push_back(std::uint32_t(q));
-          }
-    }
-  }
-  return out;
-}
-
-Volume upsample(const Volume& coarse, const Volume& like) {
-  Volume out(like.nx(), like.ny(), like.nz(), 1, 0.0f, like.transform());
-  StageProgress quiet(nullptr, {}, 0.0, 0.0, std::size_t(like.nz()));
-  parallel_chunks(std::size_t(like.nz()), 1, quiet, [&](std::size_t z0, std::size_t z1) {
-    for (int z = int(z0); z < int(z1); ++z)
-      for (int y = 0; y < like.ny(); ++y)
-        for (int x = 0; x < like.nx(); ++x) out.at(x, y, z) = trilinear(coarse, 0.5f * x, 0.5f * y, 0.5f * z);
-  });
-  return out;
-}
-
-// The coarser level's sweep distance at this level's voxels (x2: voxel
-// units halve), averaged over the coarse corners that have one.
-std::vector<float> upsample_phi(const Volume& phi_coarse, const Volume& has_coarse, const Volume& level,
-                                const std::vector<std::uint32_t>& voxels) {
-  if (phi_coarse.empty()) return {};
-  std::vector<float> out(voxels.size(), 0.0f);
-  for (std::size_t i = 0; i < voxels.size(); ++i) {
-    const Vec3 g = 0.5f * voxel_position(level, voxels[i]);
-    const float w = trilinear(has_coarse, g.x(), g.y(), g.z());
-    out[i] = w > 1e-6f ? 2.0f * trilinear(phi_coarse, g.x(), g.y(), g.z()) / w : 0.0f;
-  }
-  return out;
-}
-
-AnalogyResult run(const Volume& a, const Volume& a_prime, const Volume* field_a, const Volume& b,
-                  const Volume* field_b, const AnalogyOptions& opt, ExecContext* ctx) {
+// Every bad input named with its fix, before any work.
+void validate(const Volume& a, const Volume& a_prime, const Volume* field_a, const Volume& b, const Volume* field_b,
+              const AnalogyOptions& opt) {
   check_volume(a, "A");
   check_volume(a_prime, "A'");
   check_volume(b, "B");
@@ -244,11 +115,17 @@ AnalogyResult run(const Volume& a, const Volume& a_prime, const Volume* field_a,
                                  opt.a_region.ny() != a.ny() || opt.a_region.nz() != a.nz()))
     throw InvalidInput("a_region must have 1 channel on A's grid (" + size_of(a) + "), got " + size_of(opt.a_region) +
                        " with " + std::to_string(opt.a_region.channels()) + " channels");
-  const bool aligned = field_a != nullptr;
-  if (aligned) {
+  if (field_a) {
     check_field(*field_a, a, "field_a", "A");
     check_field(*field_b, b, "field_b", "B");
   }
+
+}
+
+AnalogyResult run(const Volume& a, const Volume& a_prime, const Volume* field_a, const Volume& b,
+                  const Volume* field_b, const AnalogyOptions& opt, ExecContext* ctx) {
+  validate(a, a_prime, field_a, b, field_b, opt);
+  const bool aligned = field_a != nullptr;
 
   const Neighbourhoods hood = make_neighbourhoods(opt.fine_size, opt.coarse_size, !aligned);
   const int L = opt.levels;
@@ -403,31 +280,9 @@ AnalogyResult run(const Volume& a, const Volume& a_prime, const Volume* field_a,
     std::vector<std::int32_t> source(band.size(), -1);
     std::vector<Vec3> source_at(band.size());
     const int nx = bl.nx(), ny = bl.ny(), nz = bl.nz();
-    if (has_coarser && opt.coherence > 0) {
-      // Each voxel's coarse parent (its index / 2) copied from c in the
-      // coarse A: this voxel's offset from the parent's centre, carried into
-      // A's frame, lands at 2 c + that offset in this level's A.
-      const Volume& coarse_grid = pb[std::size_t(k + 1)];
-      for (std::size_t i = 0; i < band.size(); ++i) {
-        const Vec3 g = voxel_position(bl, band[i]);
-        const int px = std::min(int(g.x()) / 2, coarse_grid.nx() - 1), py = std::min(int(g.y()) / 2, coarse_grid.ny() - 1),
-                  pz = std::min(int(g.z()) / 2, coarse_grid.nz() - 1);
-        const Vec3 parent = coarse_source_at[coarse_grid.voxel_index(px, py, pz)];
-        if (!parent.allFinite()) continue;
-        const Vec3 centre = 2.0f * parent;
-        const int cx = int(std::lround(centre.x())), cy = int(std::lround(centre.y())), cz = int(std::lround(centre.z()));
-        if (cx < 0 || cy < 0 || cz < 0 || cx >= al.nx() || cy >= al.ny() || cz >= al.nz()) continue;
-        const std::int32_t r0 = row_of[al.voxel_index(cx, cy, cz)];
-        if (r0 < 0) continue;
-        const Vec3 c = centre + a_frames[std::size_t(r0)] * (b_frames[i].transpose() * (g - 2.0f * Vec3(float(px), float(py), float(pz))));
-        const int ax = int(std::lround(c.x())), ay = int(std::lround(c.y())), az = int(std::lround(c.z()));
-        if (ax < 0 || ay < 0 || az < 0 || ax >= al.nx() || ay >= al.ny() || az >= al.nz()) continue;
-        const std::int32_t r = row_of[al.voxel_index(ax, ay, az)];
-        if (r < 0) continue;
-        source[i] = r;
-        source_at[i] = c;
-      }
-    }
+    if (has_coarser && opt.coherence > 0)
+      carry_coarse_sources(pb[std::size_t(k + 1)], coarse_source_at, bl, band, b_frames, al, a_frames, row_of, source,
+                           source_at);
     const float kappa = float((1.0 + opt.coherence) * (1.0 + opt.coherence));
     const float slack = float(opt.coherence_slack * coeffs.squaredNorm() / double(coeffs.rows()));
     // At the coarsest level a growing pass comes first (sweep -1): B' = B
