@@ -153,6 +153,8 @@ def _parser():
                    "faces whose change A' shows, e.g. exported selected faces; need not be closed)")
     p.add_argument("--field-preset", choices=analogy_ops.FIELD_PRESETS, default="around_axis",
                    help="the direction field the pattern follows (default around_axis)")
+    p.add_argument("--field", help="B's own field: .npy, one direction per vertex of --b (V by 3, e.g. from "
+                   "'run field', painted and diffused); wins over --field-preset for B (A keeps the preset)")
     p.add_argument("--axis", type=float, nargs=3, metavar=("X", "Y", "Z"), default=(0.0, 0.0, 1.0),
                    help="around_axis / along_axis: the axis in the files' coordinates (default 0 0 1)")
     p.add_argument("--curve", help="along_curve: the curve as a polyline, .obj (vertices joined by "
@@ -258,6 +260,8 @@ def _run_analogy(args):
     field = analogy_ops.FieldSpec(preset=args.field_preset, axis=tuple(args.axis), curve=curve)
 
     b = _analogy_mesh("--b", b_path, field)
+    if args.field:
+        b.field = _vertex_field(args.field, b.vertices)
     job = analogy_ops.GeometricTextureJob(
         b=b, preset=args.preset or "spikes", resolution=args.resolution, pattern_scale=args.pattern_size,
         pair_options={"dilate": {"dilation": args.dilation},
@@ -307,6 +311,22 @@ def _analogy_mesh(arg, path, field):
         raise UsageError(f"{arg}: {path} has no faces (the analogy works on solids: give a closed mesh)")
     name = os.path.splitext(os.path.basename(path))[0]
     return analogy_ops.MeshInput(name=name, vertices=verts, triangles=tris, field=field)
+
+
+def _vertex_field(path, vertices):
+    """A FieldSpec from a per-vertex direction file, or a UsageError."""
+    vectors = _load_npy("--field", path).astype(np.float64)
+    _require(vectors.shape == vertices.shape,
+             f"--field: {path} is {vectors.shape}; --b has {len(vertices)} vertices: give ({len(vertices)}, 3), "
+             "one direction per vertex (e.g. './exsynth run field --mesh' on the same file)")
+    _require(bool(np.isfinite(vectors).all()), f"--field: {path} has NaN or infinite values; fix or regenerate it")
+    length = np.linalg.norm(vectors, axis=1)
+    given = length > 1e-8 * max(1.0, float(length.max(initial=0.0)))
+    _require(bool(given.any()), f"--field: {path} is zero everywhere, so it gives the pattern no direction")
+    # Zero vectors are free: the frames fill them in from the nearest given ones.
+    return analogy_ops.FieldSpec(points=np.ascontiguousarray(vertices[given]),
+                                 vectors=np.ascontiguousarray(vectors[given] / length[given, None]),
+                                 source=os.path.basename(path))
 
 
 def _read_curve(path):

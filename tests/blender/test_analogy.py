@@ -533,6 +533,36 @@ def test_cli_a_region(tmp_path, capsys):
     assert "inside a_region" in capsys.readouterr().err
 
 
+def test_cli_field_from_run_field(tmp_path, capsys):
+    # A pipeline: './exsynth run field' writes B's field (here along the
+    # bunny's up axis), 'run analogy --field' follows it: vertical grooves,
+    # though --field-preset says around the same axis.
+    field = tmp_path / "field.npy"
+    assert cli.main(["field", "--mesh", BUNNY_OBJ, "--preset", "along_axis", "--axis", "y", "--out", str(field)]) == 0
+    out = tmp_path / "b.npy"
+    assert cli.main(["analogy", "--b", BUNNY_OBJ, "--preset", "grooves", "--resolution", "64", "--axis", "0", "1", "0",
+                     "--field", str(field), "--out", str(out)]) == 0
+    assert "field field.npy" in capsys.readouterr().out
+    verts, faces = read_obj(BUNNY_OBJ)
+    h = float((verts.astype(np.float32).max(0) - verts.astype(np.float32).min(0)).max()) / 64
+    assert groove_ratio(verts, faces, np.load(out), None, h, axis=(0, 1, 0)) < 0.9
+
+
+@pytest.mark.parametrize("field, message", [
+    (np.zeros((10, 3)), "give (1839, 3)"),
+    (np.zeros((1839, 3)), "zero everywhere"),
+    (np.full((1839, 3), np.nan), "NaN or infinite"),
+])
+def test_cli_bad_field_file(tmp_path, capsys, field, message):
+    path = tmp_path / "field.npy"
+    np.save(path, field)
+    out = tmp_path / "b.npy"
+    assert cli.main(["analogy", "--b", BUNNY_OBJ, "--preset", "grooves", "--resolution", "32", "--field", str(path),
+                     "--out", str(out)]) == 2
+    assert message in capsys.readouterr().err
+    assert not out.exists()
+
+
 @pytest.mark.parametrize("args, message", [
     (["--a-region", "r.obj", "--preset", "spikes", "--out", "x.npy"], "--a-region goes with --a"),
     (["--preset", "bumps", "--out", "x.npy"], "invalid choice"),

@@ -76,11 +76,12 @@ class FieldSpec:
     curve: np.ndarray = None  # N by 3 polyline, world space (along_curve)
     points: np.ndarray = None  # P by 3 world positions of given vectors ...
     vectors: np.ndarray = None  # ... and the P by 3 world vectors (None: the preset)
+    source: str = None  # where given vectors came from, for reports (default: the attribute)
 
     @property
     def description(self):
         if self.vectors is not None:
-            return f"'{field_ops.FIELD_ATTRIBUTE}'"
+            return self.source or f"'{field_ops.FIELD_ATTRIBUTE}'"
         if self.preset == "along_curve":
             return "along curve"
         axis = {(1.0, 0.0, 0.0): "X", (0.0, 1.0, 0.0): "Y", (0.0, 0.0, 1.0): "Z"}.get(
