@@ -276,7 +276,7 @@ const SphereRun& on_sphere(PairPreset preset) {
 
 TEST(AnalogyOnASphere, SpikesAddAreaAndVolumeAndStayAttached) {
   const SphereRun& s = on_sphere(PairPreset::Spikes);
-  EXPECT_GT(double(sign_changes(s.r.b_prime)), 1.3 * double(sign_changes(s.b)));  // measured 1.57x
+  EXPECT_GT(double(sign_changes(s.r.b_prime)), 1.3 * double(sign_changes(s.b)));  // measured 1.54x
   EXPECT_GT(inside_volume(s.r.b_prime), 1.04 * inside_volume(s.b));  // measured +10 %
   EXPECT_EQ(components(s.r.b_prime, true), 1);   // no spike floats free
   EXPECT_EQ(components(s.r.b_prime, false), 1);  // and no bubbles
@@ -300,7 +300,7 @@ TEST(AnalogyOnASphere, GroovesRunAlongTheField) {
   const SphereRun& c = on_sphere(PairPreset::Spikes);
   const auto [g_along, g_across] = along_across(g.r.b_prime, g.b, g.field);
   const auto [c_along, c_across] = along_across(c.r.b_prime, c.b, c.field);
-  EXPECT_GT(g_across / g_along, 4.0);  // measured 8.9 (the exemplar's own grooves: 18)
+  EXPECT_GT(g_across / g_along, 4.0);  // measured 8.7 (the exemplar's own grooves: 18)
   EXPECT_LT(c_across / c_along, 1.2);
   EXPECT_GT(double(sign_changes(g.r.b_prime)), 1.07 * double(sign_changes(g.b)));  // measured 1.14x
 }

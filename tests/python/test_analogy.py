@@ -67,16 +67,16 @@ def test_field_aligned_grooves_run_around_the_bunny(bunny):
     near = np.abs(vox["sdf"]) < h
     along = np.abs((grad * frames["t"]).sum(-1))[near].mean()
     across = np.abs((grad * frames["b"]).sum(-1))[near].mean()
-    assert across > 1.5 * along  # measured 1.95
-    # Grooves cut in: material more than a voxel inside B is gone (measured 4.8 % of B).
+    assert across > 1.5 * along  # measured 1.96
+    # Grooves cut in: material more than a voxel inside B is gone (measured 5.0 % of B).
     assert ((vox["sdf"] < -h) & (bp > 0)).sum() > 0.025 * (vox["sdf"] < 0).sum()
 
 
 def test_field_aligned_spikes_grow_out_of_the_bunny(bunny):
     vox, frames, res = textured_bunny(bunny, "spikes")
     bp, b, h = res["b_prime"], vox["sdf"], vox["voxel_size"]
-    assert surface_area(bp, vox["origin"], h) > 1.1 * surface_area(b, vox["origin"], h)  # measured 1.21
-    grown = (b > 2 * h) & (bp < 0)  # material two voxels or more outside B (measured 0.66 % of B)
+    assert surface_area(bp, vox["origin"], h) > 1.1 * surface_area(b, vox["origin"], h)  # measured 1.22
+    grown = (b > 2 * h) & (bp < 0)  # material two voxels or more outside B (measured 0.72 % of B)
     assert grown.sum() > 0.003 * (b < 0).sum()
 
 

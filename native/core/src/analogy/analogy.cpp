@@ -3,9 +3,13 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <map>
 #include <numeric>
 #include <string>
 #include <vector>
+
+#include <tbb/enumerable_thread_specific.h>
+#include <tbb/parallel_for.h>
 
 #include "analogy/ann_index.hpp"
 #include "analogy/band.hpp"
@@ -57,6 +61,48 @@ void check_field(const Volume& field, const Volume& sdf, const char* name, const
     throw InvalidInput(std::string(name) + " is zero or not finite at " + std::to_string(bad) + " of the " +
                        std::to_string(surface) + " voxels near " + volume_name +
                        "'s surface; give a direction at every surface point (or use a field preset)");
+}
+
+// Per-thread working storage of the visits, and their counts.
+struct Scratch {
+  Scratch(int causal_dims, int pca_dims) : fc(causal_dims), y(pca_dims) {}
+  Eigen::RowVectorXf fc, y;
+  std::vector<std::int32_t> tried;
+  std::vector<int> votes;
+  std::vector<Vec3> sums;
+  std::vector<float> dists;
+  std::size_t searched = 0, coherent = 0, ann_skipped = 0;
+  void add(const Scratch& o) {
+    searched += o.searched, coherent += o.coherent, ann_skipped += o.ann_skipped;
+  }
+};
+
+// Edge of the sweep tiles in voxels: more than twice the farthest a visit
+// reads (the 5^3 causal cube turned in its frame, trilinear: < 5 voxels).
+constexpr int kTile = 16;
+
+int tile_colour(const Volume& grid, const std::vector<std::uint32_t>& band, const std::vector<std::uint32_t>& tile,
+                int edge) {
+  const Vec3 g = voxel_position(grid, band[tile.front()]);
+  return (int(g.x()) / edge & 1) | (int(g.y()) / edge & 1) << 1 | (int(g.z()) / edge & 1) << 2;
+}
+
+// The band split into tiles of edge^3 voxels, each tile's positions in
+// `order`; tiles by increasing index.
+std::vector<std::vector<std::uint32_t>> tiles_in_order(const Volume& grid, const std::vector<std::uint32_t>& band,
+                                                       const std::vector<std::uint32_t>& order, int edge) {
+  const int tx = (grid.nx() + edge - 1) / edge, ty = (grid.ny() + edge - 1) / edge;
+  std::map<std::size_t, std::vector<std::uint32_t>> by_tile;
+  for (const std::uint32_t i : order) {
+    const Vec3 g = voxel_position(grid, band[i]);
+    const std::size_t key = (std::size_t(int(g.z()) / edge) * std::size_t(ty) + std::size_t(int(g.y()) / edge)) *
+                                std::size_t(tx) + std::size_t(int(g.x()) / edge);
+    by_tile[key].push_back(i);
+  }
+  std::vector<std::vector<std::uint32_t>> tiles;
+  tiles.reserve(by_tile.size());
+  for (auto& [key, positions] : by_tile) tiles.push_back(std::move(positions));
+  return tiles;
 }
 
 // Each voxel of this level's band starts from its coarse parent's source
@@ -302,103 +348,127 @@ AnalogyResult run(const Volume& a, const Volume& a_prime, const Volume* field_a,
     if (grow) grow_order = breadth_first(bl, band, band_of, order);
     StageProgress synth(ctx, stage + " synthesis", p0 + 0.2 * (p1 - p0), p1,
                         std::size_t(opt.sweeps + (grow ? 1 : 0)) * band.size());
-    Eigen::RowVectorXf fc(C), y(d);
-    std::vector<std::int32_t> tried;
-    std::vector<int> votes;
-    std::vector<Vec3> sums;
-    std::vector<float> cand_dists;
-    for (int sweep = grow ? -1 : 0; sweep < opt.sweeps; ++sweep)
-      for (std::size_t n = 0; n < order.size(); ++n) {
+    // One visit: the voxel at band position i takes its best candidate.
+    // Reads B' and the sources within a few voxels, writes only its own.
+    const auto visit = [&](std::uint32_t i, bool growing, Scratch& sc) {
+      const std::uint32_t v = band[i];
+      const Vec3 g = voxel_position(bl, v);
+      const Frame& f = b_frames[i];
+      causal_features(b_side, hood, g, f, sc.fc.data());
+      Eigen::RowVectorXf& y = sc.y;
+      y.noalias() = fixed.row(Eigen::Index(i)) + sc.fc * basis_causal;
+
+      // Coherent candidates: each visited neighbour's source, moved back
+      // by the neighbour's offset expressed in the source's frame. Among
+      // those close enough to the nearest neighbour's distance, the one
+      // most neighbours agree on wins (then the closer): a patch of B'
+      // keeps copying one piece of A' rigidly, pattern and all, instead of
+      // drifting to whichever candidate happens to be pattern-free.
+      sc.tried.clear();
+      sc.votes.clear();
+      sc.sums.clear();
+      const int x0 = int(g.x()), y0 = int(g.y()), z0 = int(g.z());
+      for (int dz = -1; dz <= 1; ++dz)
+        for (int dy = -1; dy <= 1; ++dy)
+          for (int dx = -1; dx <= 1; ++dx) {
+            const int qx = x0 + dx, qy = y0 + dy, qz = z0 + dz;
+            if ((dx | dy | dz) == 0 || qx < 0 || qy < 0 || qz < 0 || qx >= nx || qy >= ny || qz >= nz) continue;
+            const std::int32_t q = band_of[bl.voxel_index(qx, qy, qz)];
+            if (q < 0 || source[std::size_t(q)] < 0) continue;
+            const std::int32_t s = source[std::size_t(q)];
+            // The offset in the neighbour's own frame: a source that is A rotated onto
+            // B stays exactly so (with the centre's frame it would drift).
+            const Vec3 local = b_frames[std::size_t(q)].transpose() * Vec3(float(-dx), float(-dy), float(-dz));
+            const Vec3 c = source_at[std::size_t(q)] + a_frames[std::size_t(s)] * local;
+            // Neighbours of one patch propose (nearly) the same position:
+            // they vote together even when rounding would split them.
+            std::size_t k = 0;
+            while (k < sc.sums.size() && (sc.sums[k] / float(sc.votes[k]) - c).squaredNorm() > 0.5f) ++k;
+            if (k < sc.sums.size()) {
+              ++sc.votes[k];
+              sc.sums[k] += c;
+            } else {
+              sc.votes.push_back(1);
+              sc.sums.push_back(c);
+            }
+          }
+      // Each proposal's database row: the A voxel nearest its mean position.
+      sc.tried.resize(sc.sums.size());
+      for (std::size_t k = 0; k < sc.sums.size(); ++k) {
+        const Vec3 c = sc.sums[k] / float(sc.votes[k]);
+        const int cx = int(std::lround(c.x())), cy = int(std::lround(c.y())), cz = int(std::lround(c.z()));
+        const bool inside = cx >= 0 && cy >= 0 && cz >= 0 && cx < al.nx() && cy < al.ny() && cz < al.nz();
+        sc.tried[k] = inside ? row_of[al.voxel_index(cx, cy, cz)] : -1;
+      }
+      // The candidate most neighbours agree on (then the closest). If it is
+      // within the slack, the rule below would take it whatever the
+      // nearest neighbour's distance (>= 0): skip the k-d tree query.
+      std::vector<float>& dists = sc.dists;
+      dists.resize(sc.tried.size());
+      std::size_t top = sc.tried.size();
+      for (std::size_t c = 0; c < sc.tried.size(); ++c) {
+        if (sc.tried[c] < 0) {  // off A's database: no candidate
+          dists[c] = std::numeric_limits<float>::infinity();
+          continue;
+        }
+        dists[c] = (coeffs.row(sc.tried[c]) - y).squaredNorm();
+        if (top == sc.tried.size() || sc.votes[c] > sc.votes[top] || (sc.votes[c] == sc.votes[top] && dists[c] < dists[top])) top = c;
+      }
+      std::int32_t best;
+      Vec3 at;
+      int best_votes = 0;
+      if (top < sc.tried.size() && (growing || dists[top] <= slack)) {
+        best = sc.tried[top], best_votes = sc.votes[top], at = sc.sums[top] / float(sc.votes[top]);
+        ++sc.ann_skipped;
+      } else {
+        const std::int32_t nearest = std::int32_t(index.nearest(y.data(), float(opt.ann_eps)));
+        const float accept = (coeffs.row(nearest) - y).squaredNorm() * kappa + slack;
+        best = nearest;
+        at = voxel_position(al, a_voxels[std::size_t(nearest)]);
+        float best_d = std::numeric_limits<float>::infinity();
+        for (std::size_t c = 0; c < sc.tried.size(); ++c) {
+          if (dists[c] > accept || sc.votes[c] < best_votes || (sc.votes[c] == best_votes && dists[c] >= best_d)) continue;
+          best = sc.tried[c], best_votes = sc.votes[c], best_d = dists[c];
+          at = sc.sums[c] / float(sc.votes[c]);
+        }
+      }
+      if (best_votes) ++sc.coherent;
+      bp.data()[v] = trilinear(apl, at.x(), at.y(), at.z());
+      source[i] = best;
+      source_at[i] = at;
+      ++sc.searched;
+    };
+    Scratch serial(C, d);
+    if (grow) {
+      for (std::size_t n = 0; n < grow_order.size(); ++n) {
         if ((n & 1023) == 0) {
           synth.check();
           if (n) synth.advance(1024);
         }
-        const std::uint32_t i = (sweep < 0 ? grow_order : order)[n], v = band[i];
-        const Vec3 g = voxel_position(bl, v);
-        const Frame& f = b_frames[i];
-        causal_features(b_side, hood, g, f, fc.data());
-        y.noalias() = fixed.row(Eigen::Index(i)) + fc * basis_causal;
-
-        // Coherent candidates: each visited neighbour's source, moved back
-        // by the neighbour's offset expressed in the source's frame. Among
-        // those close enough to the nearest neighbour's distance, the one
-        // most neighbours agree on wins (then the closer): a patch of B'
-        // keeps copying one piece of A' rigidly, pattern and all, instead of
-        // drifting to whichever candidate happens to be pattern-free.
-        tried.clear();
-        votes.clear();
-        sums.clear();
-        const int x0 = int(g.x()), y0 = int(g.y()), z0 = int(g.z());
-        for (int dz = -1; dz <= 1; ++dz)
-          for (int dy = -1; dy <= 1; ++dy)
-            for (int dx = -1; dx <= 1; ++dx) {
-              const int qx = x0 + dx, qy = y0 + dy, qz = z0 + dz;
-              if ((dx | dy | dz) == 0 || qx < 0 || qy < 0 || qz < 0 || qx >= nx || qy >= ny || qz >= nz) continue;
-              const std::int32_t q = band_of[bl.voxel_index(qx, qy, qz)];
-              if (q < 0 || source[std::size_t(q)] < 0) continue;
-              const std::int32_t s = source[std::size_t(q)];
-              // The offset in the neighbour's own frame: a source that is A rotated onto
-              // B stays exactly so (with the centre's frame it would drift).
-              const Vec3 local = b_frames[std::size_t(q)].transpose() * Vec3(float(-dx), float(-dy), float(-dz));
-              const Vec3 c = source_at[std::size_t(q)] + a_frames[std::size_t(s)] * local;
-              // Neighbours of one patch propose (nearly) the same position:
-              // they vote together even when rounding would split them.
-              std::size_t k = 0;
-              while (k < sums.size() && (sums[k] / float(votes[k]) - c).squaredNorm() > 0.5f) ++k;
-              if (k < sums.size()) {
-                ++votes[k];
-                sums[k] += c;
-              } else {
-                votes.push_back(1);
-                sums.push_back(c);
-              }
-            }
-        // Each proposal's database row: the A voxel nearest its mean position.
-        tried.resize(sums.size());
-        for (std::size_t k = 0; k < sums.size(); ++k) {
-          const Vec3 c = sums[k] / float(votes[k]);
-          const int cx = int(std::lround(c.x())), cy = int(std::lround(c.y())), cz = int(std::lround(c.z()));
-          const bool inside = cx >= 0 && cy >= 0 && cz >= 0 && cx < al.nx() && cy < al.ny() && cz < al.nz();
-          tried[k] = inside ? row_of[al.voxel_index(cx, cy, cz)] : -1;
-        }
-        // The candidate most neighbours agree on (then the closest). If it is
-        // within the slack, the rule below would take it whatever the
-        // nearest neighbour's distance (>= 0): skip the k-d tree query.
-        std::vector<float>& dists = cand_dists;
-        dists.resize(tried.size());
-        std::size_t top = tried.size();
-        for (std::size_t c = 0; c < tried.size(); ++c) {
-          if (tried[c] < 0) {  // off A's database: no candidate
-            dists[c] = std::numeric_limits<float>::infinity();
-            continue;
-          }
-          dists[c] = (coeffs.row(tried[c]) - y).squaredNorm();
-          if (top == tried.size() || votes[c] > votes[top] || (votes[c] == votes[top] && dists[c] < dists[top])) top = c;
-        }
-        std::int32_t best;
-        Vec3 at;
-        int best_votes = 0;
-        if (top < tried.size() && (sweep < 0 || dists[top] <= slack)) {
-          best = tried[top], best_votes = votes[top], at = sums[top] / float(votes[top]);
-          ++result.ann_skipped;
-        } else {
-          const std::int32_t nearest = std::int32_t(index.nearest(y.data(), float(opt.ann_eps)));
-          const float accept = (coeffs.row(nearest) - y).squaredNorm() * kappa + slack;
-          best = nearest;
-          at = voxel_position(al, a_voxels[std::size_t(nearest)]);
-          float best_d = std::numeric_limits<float>::infinity();
-          for (std::size_t c = 0; c < tried.size(); ++c) {
-            if (dists[c] > accept || votes[c] < best_votes || (votes[c] == best_votes && dists[c] >= best_d)) continue;
-            best = tried[c], best_votes = votes[c], best_d = dists[c];
-            at = sums[c] / float(votes[c]);
-          }
-        }
-        if (best_votes) ++result.coherent;
-        bp.data()[v] = trilinear(apl, at.x(), at.y(), at.z());
-        source[i] = best;
-        source_at[i] = at;
-        ++result.searched;
+        visit(grow_order[n], true, serial);
       }
+    }
+    // The sweeps run tile by tile, in sweep order inside a tile. Tiles of
+    // one colour (the parity of their x, y, z tile index) are a tile apart,
+    // farther than any visit reads, so they run in parallel and the result
+    // does not depend on the number of threads; the colours run in turn.
+    const std::vector<std::vector<std::uint32_t>> tiles = tiles_in_order(bl, band, order, kTile);
+    tbb::enumerable_thread_specific<Scratch> scratch([&] { return Scratch(C, d); });
+    for (int sweep = 0; sweep < opt.sweeps; ++sweep)
+      for (int colour = 0; colour < 8; ++colour) {
+        synth.check();
+        tbb::parallel_for(std::size_t(0), tiles.size(), [&](std::size_t t) {
+          if (tile_colour(bl, band, tiles[t], kTile) != colour) return;
+          synth.check();
+          Scratch& sc = scratch.local();
+          for (const std::uint32_t i : tiles[t]) visit(i, false, sc);
+          synth.advance(tiles[t].size());
+        });
+      }
+    for (const Scratch& sc : scratch) serial.add(sc);
+    result.searched += serial.searched;
+    result.coherent += serial.coherent;
+    result.ann_skipped += serial.ann_skipped;
     if (l + 1 < L) {
       coarse_source_at.assign(bl.voxel_count(), Vec3::Constant(std::numeric_limits<float>::quiet_NaN()));
       for (std::size_t i = 0; i < band.size(); ++i)
