@@ -21,7 +21,7 @@ def test_dilation_pair_grows_the_voxelized_bunny(bunny):
     assert bp.shape == b.shape and bp.dtype == np.float32
     assert res["culled"] > 0 and res["searched"] > 0
     # The pair dilates by 0.15 (2.4 voxels): B' should be B's exact offset
-    # surface B - 0.15 (measured: volume within 1.2 %, 92 % of voxels agree).
+    # surface B - 0.15 (measured: volume within 3.2 %, 88 % of voxels agree).
     exact = b - 0.15
     assert inside(bp, h) == pytest.approx(inside(exact, h), rel=0.05)
     assert ((exact < 0) != (bp < 0)).sum() < 0.15 * (exact < 0).sum()
