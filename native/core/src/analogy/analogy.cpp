@@ -1,6 +1,7 @@
 #include "exsynth/analogy.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 #include <map>
@@ -63,14 +64,22 @@ void check_field(const Volume& field, const Volume& sdf, const char* name, const
                        "'s surface; give a direction at every surface point (or use a field preset)");
 }
 
+// The database row of the A voxel nearest position c (A's level grid), or
+// -1 when c is off the grid or that voxel is not in the database.
+std::int32_t row_near(const Volume& al, const std::vector<std::int32_t>& row_of, const Vec3& c) {
+  const int x = int(std::lround(c.x())), y = int(std::lround(c.y())), z = int(std::lround(c.z()));
+  if (x < 0 || y < 0 || z < 0 || x >= al.nx() || y >= al.ny() || z >= al.nz()) return -1;
+  return row_of[al.voxel_index(x, y, z)];
+}
+
 // Per-thread working storage of the visits, and their counts.
 struct Scratch {
   Scratch(int causal_dims, int pca_dims) : fc(causal_dims), y(pca_dims) {}
   Eigen::RowVectorXf fc, y;
-  std::vector<std::int32_t> tried;
-  std::vector<int> votes;
-  std::vector<Vec3> sums;
-  std::vector<float> dists;
+  std::vector<Vec3> sums;             // per proposed position: sum of the proposals ...
+  std::vector<int> votes;             // ... how many neighbours proposed it ...
+  std::vector<std::int32_t> rows;     // ... its database row (-1: none) ...
+  std::vector<float> dists;           // ... and its feature distance
   std::size_t searched = 0, coherent = 0, ann_skipped = 0;
   void add(const Scratch& o) {
     searched += o.searched, coherent += o.coherent, ann_skipped += o.ann_skipped;
@@ -81,16 +90,13 @@ struct Scratch {
 // reads (the 5^3 causal cube turned in its frame, trilinear: < 5 voxels).
 constexpr int kTile = 16;
 
-int tile_colour(const Volume& grid, const std::vector<std::uint32_t>& band, const std::vector<std::uint32_t>& tile,
-                int edge) {
-  const Vec3 g = voxel_position(grid, band[tile.front()]);
-  return (int(g.x()) / edge & 1) | (int(g.y()) / edge & 1) << 1 | (int(g.z()) / edge & 1) << 2;
-}
+using Tiles = std::vector<std::vector<std::uint32_t>>;
 
 // The band split into tiles of edge^3 voxels, each tile's positions in
-// `order`; tiles by increasing index.
-std::vector<std::vector<std::uint32_t>> tiles_in_order(const Volume& grid, const std::vector<std::uint32_t>& band,
-                                                       const std::vector<std::uint32_t>& order, int edge) {
+// `order`, grouped by the tile's colour (the parity of its x, y and z tile
+// index: 8 colours); tiles of a colour by increasing index.
+std::array<Tiles, 8> tiles_by_colour(const Volume& grid, const std::vector<std::uint32_t>& band,
+                                     const std::vector<std::uint32_t>& order, int edge) {
   const int tx = (grid.nx() + edge - 1) / edge, ty = (grid.ny() + edge - 1) / edge;
   std::map<std::size_t, std::vector<std::uint32_t>> by_tile;
   for (const std::uint32_t i : order) {
@@ -99,9 +105,12 @@ std::vector<std::vector<std::uint32_t>> tiles_in_order(const Volume& grid, const
                                 std::size_t(tx) + std::size_t(int(g.x()) / edge);
     by_tile[key].push_back(i);
   }
-  std::vector<std::vector<std::uint32_t>> tiles;
-  tiles.reserve(by_tile.size());
-  for (auto& [key, positions] : by_tile) tiles.push_back(std::move(positions));
+  std::array<Tiles, 8> tiles;
+  for (auto& [key, positions] : by_tile) {
+    const std::size_t x = key % std::size_t(tx), y = key / std::size_t(tx) % std::size_t(ty),
+                      z = key / (std::size_t(tx) * std::size_t(ty));
+    tiles[(x & 1) | (y & 1) << 1 | (z & 1) << 2].push_back(std::move(positions));
+  }
   return tiles;
 }
 
@@ -114,11 +123,6 @@ void carry_coarse_sources(const Volume& coarse_grid, const std::vector<Vec3>& co
                           const std::vector<std::uint32_t>& band, const std::vector<Frame>& b_frames, const Volume& al,
                           const std::vector<Frame>& a_frames, const std::vector<std::int32_t>& row_of,
                           std::vector<std::int32_t>& source, std::vector<Vec3>& source_at) {
-  auto row_near = [&](const Vec3& c) -> std::int32_t {
-    const int x = int(std::lround(c.x())), y = int(std::lround(c.y())), z = int(std::lround(c.z()));
-    if (x < 0 || y < 0 || z < 0 || x >= al.nx() || y >= al.ny() || z >= al.nz()) return -1;
-    return row_of[al.voxel_index(x, y, z)];
-  };
   for (std::size_t i = 0; i < band.size(); ++i) {
     const Vec3 g = voxel_position(bl, band[i]);
     const int px = std::min(int(g.x()) / 2, coarse_grid.nx() - 1), py = std::min(int(g.y()) / 2, coarse_grid.ny() - 1),
@@ -126,11 +130,11 @@ void carry_coarse_sources(const Volume& coarse_grid, const std::vector<Vec3>& co
     const Vec3 parent = coarse_source_at[coarse_grid.voxel_index(px, py, pz)];
     if (!parent.allFinite()) continue;
     const Vec3 centre = 2.0f * parent;
-    const std::int32_t r0 = row_near(centre);
+    const std::int32_t r0 = row_near(al, row_of, centre);
     if (r0 < 0) continue;
     const Vec3 c = centre + a_frames[std::size_t(r0)] *
                                 (b_frames[i].transpose() * (g - 2.0f * Vec3(float(px), float(py), float(pz))));
-    const std::int32_t r = row_near(c);
+    const std::int32_t r = row_near(al, row_of, c);
     if (r < 0) continue;
     source[i] = r;
     source_at[i] = c;
@@ -165,7 +169,6 @@ void validate(const Volume& a, const Volume& a_prime, const Volume* field_a, con
     check_field(*field_a, a, "field_a", "A");
     check_field(*field_b, b, "field_b", "B");
   }
-
 }
 
 AnalogyResult run(const Volume& a, const Volume& a_prime, const Volume* field_a, const Volume& b,
@@ -279,7 +282,6 @@ AnalogyResult run(const Volume& a, const Volume& a_prime, const Volume* field_a,
     std::vector<std::uint32_t> band;
     for (std::uint32_t i = 0; i < std::uint32_t(bl.voxel_count()); ++i)
       if (cull <= 0 || (bp.data()[i] <= cull_out && bp.data()[i] >= -cull_in)) band.push_back(i);
-    result.culled += std::size_t(opt.sweeps) * (bl.voxel_count() - band.size());
     const std::vector<Frame> b_frames = analogy::frames_at(bl, aligned ? *field_b : no_field, scale, band, nullptr);
 
     // Visit order: scanline (the band is sorted by index) or sweep distance.
@@ -317,7 +319,7 @@ AnalogyResult run(const Volume& a, const Volume& a_prime, const Volume* field_a,
       });
     }
 
-    // ---- Sweeps. Causal: one voxel after another, no parallelism.
+    // ---- The growing pass and the sweeps.
     // Where each band voxel copied from: a continuous position in A (a
     // coherent continuation is not rounded, so a patch wrapped over a curved
     // B does not jitter) and the database row nearest to it.
@@ -331,7 +333,7 @@ AnalogyResult run(const Volume& a, const Volume& a_prime, const Volume* field_a,
                            source_at);
     const float kappa = float((1.0 + opt.coherence) * (1.0 + opt.coherence));
     const float slack = float(opt.coherence_slack * coeffs.squaredNorm() / double(coeffs.rows()));
-    // At the coarsest level a growing pass comes first (sweep -1): B' = B
+    // At the coarsest level a growing pass comes first: B' = B
     // would make every causal neighbourhood pattern-free, so the first
     // choices would all be pattern-free places of A' and, along the field,
     // stay so. Instead each voxel takes the position its visited neighbours
@@ -346,8 +348,9 @@ AnalogyResult run(const Volume& a, const Volume& a_prime, const Volume* field_a,
     // every minimum would start a copy of its own.)
     std::vector<std::uint32_t> grow_order;
     if (grow) grow_order = breadth_first(bl, band, band_of, order);
-    StageProgress synth(ctx, stage + " synthesis", p0 + 0.2 * (p1 - p0), p1,
-                        std::size_t(opt.sweeps + (grow ? 1 : 0)) * band.size());
+    const std::size_t passes = std::size_t(opt.sweeps + (grow ? 1 : 0));
+    result.culled += passes * (bl.voxel_count() - band.size());
+    StageProgress synth(ctx, stage + " synthesis", p0 + 0.2 * (p1 - p0), p1, passes * band.size());
     // One visit: the voxel at band position i takes its best candidate.
     // Reads B' and the sources within a few voxels, writes only its own.
     const auto visit = [&](std::uint32_t i, bool growing, Scratch& sc) {
@@ -364,7 +367,6 @@ AnalogyResult run(const Volume& a, const Volume& a_prime, const Volume* field_a,
       // most neighbours agree on wins (then the closer): a patch of B'
       // keeps copying one piece of A' rigidly, pattern and all, instead of
       // drifting to whichever candidate happens to be pattern-free.
-      sc.tried.clear();
       sc.votes.clear();
       sc.sums.clear();
       const int x0 = int(g.x()), y0 = int(g.y()), z0 = int(g.z());
@@ -393,32 +395,27 @@ AnalogyResult run(const Volume& a, const Volume& a_prime, const Volume* field_a,
             }
           }
       // Each proposal's database row: the A voxel nearest its mean position.
-      sc.tried.resize(sc.sums.size());
-      for (std::size_t k = 0; k < sc.sums.size(); ++k) {
-        const Vec3 c = sc.sums[k] / float(sc.votes[k]);
-        const int cx = int(std::lround(c.x())), cy = int(std::lround(c.y())), cz = int(std::lround(c.z()));
-        const bool inside = cx >= 0 && cy >= 0 && cz >= 0 && cx < al.nx() && cy < al.ny() && cz < al.nz();
-        sc.tried[k] = inside ? row_of[al.voxel_index(cx, cy, cz)] : -1;
-      }
+      sc.rows.resize(sc.sums.size());
+      for (std::size_t k = 0; k < sc.sums.size(); ++k) sc.rows[k] = row_near(al, row_of, sc.sums[k] / float(sc.votes[k]));
       // The candidate most neighbours agree on (then the closest). If it is
       // within the slack, the rule below would take it whatever the
       // nearest neighbour's distance (>= 0): skip the k-d tree query.
       std::vector<float>& dists = sc.dists;
-      dists.resize(sc.tried.size());
-      std::size_t top = sc.tried.size();
-      for (std::size_t c = 0; c < sc.tried.size(); ++c) {
-        if (sc.tried[c] < 0) {  // off A's database: no candidate
+      dists.resize(sc.rows.size());
+      std::size_t top = sc.rows.size();
+      for (std::size_t c = 0; c < sc.rows.size(); ++c) {
+        if (sc.rows[c] < 0) {  // off A's database: no candidate
           dists[c] = std::numeric_limits<float>::infinity();
           continue;
         }
-        dists[c] = (coeffs.row(sc.tried[c]) - y).squaredNorm();
-        if (top == sc.tried.size() || sc.votes[c] > sc.votes[top] || (sc.votes[c] == sc.votes[top] && dists[c] < dists[top])) top = c;
+        dists[c] = (coeffs.row(sc.rows[c]) - y).squaredNorm();
+        if (top == sc.rows.size() || sc.votes[c] > sc.votes[top] || (sc.votes[c] == sc.votes[top] && dists[c] < dists[top])) top = c;
       }
       std::int32_t best;
       Vec3 at;
       int best_votes = 0;
-      if (top < sc.tried.size() && (growing || dists[top] <= slack)) {
-        best = sc.tried[top], best_votes = sc.votes[top], at = sc.sums[top] / float(sc.votes[top]);
+      if (top < sc.rows.size() && (growing || dists[top] <= slack)) {
+        best = sc.rows[top], best_votes = sc.votes[top], at = sc.sums[top] / float(sc.votes[top]);
         ++sc.ann_skipped;
       } else {
         const std::int32_t nearest = std::int32_t(index.nearest(y.data(), float(opt.ann_eps)));
@@ -426,9 +423,9 @@ AnalogyResult run(const Volume& a, const Volume& a_prime, const Volume* field_a,
         best = nearest;
         at = voxel_position(al, a_voxels[std::size_t(nearest)]);
         float best_d = std::numeric_limits<float>::infinity();
-        for (std::size_t c = 0; c < sc.tried.size(); ++c) {
+        for (std::size_t c = 0; c < sc.rows.size(); ++c) {
           if (dists[c] > accept || sc.votes[c] < best_votes || (sc.votes[c] == best_votes && dists[c] >= best_d)) continue;
-          best = sc.tried[c], best_votes = sc.votes[c], best_d = dists[c];
+          best = sc.rows[c], best_votes = sc.votes[c], best_d = dists[c];
           at = sc.sums[c] / float(sc.votes[c]);
         }
       }
@@ -452,17 +449,16 @@ AnalogyResult run(const Volume& a, const Volume& a_prime, const Volume* field_a,
     // one colour (the parity of their x, y, z tile index) are a tile apart,
     // farther than any visit reads, so they run in parallel and the result
     // does not depend on the number of threads; the colours run in turn.
-    const std::vector<std::vector<std::uint32_t>> tiles = tiles_in_order(bl, band, order, kTile);
+    const std::array<Tiles, 8> tiles = tiles_by_colour(bl, band, order, kTile);
     tbb::enumerable_thread_specific<Scratch> scratch([&] { return Scratch(C, d); });
     for (int sweep = 0; sweep < opt.sweeps; ++sweep)
-      for (int colour = 0; colour < 8; ++colour) {
+      for (const Tiles& colour : tiles) {
         synth.check();
-        tbb::parallel_for(std::size_t(0), tiles.size(), [&](std::size_t t) {
-          if (tile_colour(bl, band, tiles[t], kTile) != colour) return;
+        tbb::parallel_for(std::size_t(0), colour.size(), [&](std::size_t t) {
           synth.check();
           Scratch& sc = scratch.local();
-          for (const std::uint32_t i : tiles[t]) visit(i, false, sc);
-          synth.advance(tiles[t].size());
+          for (const std::uint32_t i : colour[t]) visit(i, false, sc);
+          synth.advance(colour[t].size());
         });
       }
     for (const Scratch& sc : scratch) serial.add(sc);
