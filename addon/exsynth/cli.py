@@ -288,9 +288,7 @@ def _run_analogy(args):
     if out_ext == ".obj":
         export_obj(args.out, analogy_ops.result_name(result), *result.surface)
     elif out_ext == ".vdb":
-        h = result.voxel_size
-        density = np.clip(0.5 - result.b_prime / h, 0.0, 1.0).astype(np.float32)
-        _native.write_vdb(args.out, {"sdf": result.b_prime, "density": density}, result.origin, h)
+        _native.write_vdb(args.out, result.grids(), result.origin, result.voxel_size)
     else:
         np.save(args.out, np.ascontiguousarray(result.b_prime, np.float32))
     nx, ny, nz = result.dims_xyz

@@ -105,6 +105,22 @@ def cancel_once_running(seen):
     return hook
 
 
+def add_camera(name="Cam"):
+    """A camera object, linked: the not-a-mesh (or not-a-curve) input."""
+    cam = bpy.data.objects.new(name, bpy.data.cameras.new(name))
+    bpy.context.collection.objects.link(cam)
+    return cam
+
+
+def read_obj(path):
+    """Vertices and triangles of an OBJ file the CLI wrote."""
+    lines = open(path).read().splitlines()
+    verts = np.array([l.split()[1:4] for l in lines if l.startswith("v ")], np.float64)
+    faces = np.array([[int(t.split("/")[0]) - 1 for t in l.split()[1:4]]
+                      for l in lines if l.startswith("f ")], np.int64)
+    return verts, faces
+
+
 def add_faceless_mesh(name="Dots"):
     """A mesh object with three vertices and no faces, linked and active:
     the 'mesh has no faces' bad input every mesh operator must refuse."""

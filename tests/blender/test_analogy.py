@@ -12,7 +12,7 @@ import pytest
 
 from exsynth import _native, cli, jobs
 from exsynth.io import mesh as mesh_io
-from helpers import BUNNY_OBJ, add_faceless_mesh, enclosed_volume, scene_state, world_mesh
+from helpers import BUNNY_OBJ, add_camera, add_faceless_mesh, enclosed_volume, read_obj, scene_state, world_mesh
 
 RESOLUTION = 48  # quick runs; the measured properties use 64
 
@@ -364,8 +364,7 @@ def test_no_active_mesh(bunny):
 
 
 def test_active_object_is_not_a_mesh(bunny):
-    cam = bpy.data.objects.new("Cam", bpy.data.cameras.new("Cam"))
-    bpy.context.collection.objects.link(cam)
+    cam = add_camera()
     bpy.context.view_layer.objects.active = cam
     run_expecting_error(r"'Cam' is a camera, not a mesh\. Select a mesh object")
 
@@ -446,14 +445,6 @@ def test_edit_mode(bunny):
 
 
 # ---- CLI -----------------------------------------------------------------------
-def read_obj(path):
-    lines = open(path).read().splitlines()
-    verts = np.array([l.split()[1:4] for l in lines if l.startswith("v ")], np.float64)
-    faces = np.array([[int(t.split("/")[0]) - 1 for t in l.split()[1:4]]
-                      for l in lines if l.startswith("f ")], np.int64)
-    return verts, faces
-
-
 def test_cli_spikes_obj(tmp_path, capsys):
     # The OBJ is Y-up and the CLI keeps the file's axes: around its Y axis.
     out = tmp_path / "sub" / "spikes.obj"

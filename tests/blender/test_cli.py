@@ -5,17 +5,9 @@ import numpy as np
 import pytest
 
 from exsynth import _native, cli
-from helpers import BUNNY_OBJ, enclosed_volume
+from helpers import BUNNY_OBJ, enclosed_volume, read_obj
 
 RES = ["--resolution", "40"]
-
-
-def read_obj(path):
-    lines = open(path).read().splitlines()
-    verts = np.array([l.split()[1:4] for l in lines if l.startswith("v ")], np.float64)
-    faces = np.array([[int(t.split("/")[0]) - 1 for t in l.split()[1:4]]
-                      for l in lines if l.startswith("f ")], np.int64)
-    return verts, faces
 
 
 @pytest.fixture(scope="module")

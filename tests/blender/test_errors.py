@@ -6,7 +6,7 @@ carrying the operator's error report."""
 import bpy
 import pytest
 
-from helpers import add_faceless_mesh, scene_state
+from helpers import add_camera, add_faceless_mesh, scene_state
 
 
 def run_expecting_error(match):
@@ -22,8 +22,7 @@ def test_no_active_object(bunny):
 
 
 def test_active_object_is_not_a_mesh(bunny):
-    cam = bpy.data.objects.new("Cam", bpy.data.cameras.new("Cam"))
-    bpy.context.collection.objects.link(cam)
+    cam = add_camera()
     bpy.context.view_layer.objects.active = cam
     run_expecting_error(r"'Cam' is a camera, not a mesh\. Select a mesh object")
 

@@ -8,7 +8,7 @@ import pytest
 
 from exsynth import _native, cli, jobs
 from exsynth.operators import field as field_ops
-from helpers import BUNNY_OBJ, add_faceless_mesh, scene_state
+from helpers import BUNNY_OBJ, add_camera, add_faceless_mesh, scene_state
 
 FIELD = "exsynth_field"
 
@@ -162,8 +162,7 @@ def run_expecting_error(match, obj=None):
 def test_no_active_mesh(bunny):
     bpy.context.view_layer.objects.active = None
     run_expecting_error(r"no active object\. Select the mesh")
-    cam = bpy.data.objects.new("Cam", bpy.data.cameras.new("Cam"))
-    bpy.context.collection.objects.link(cam)
+    cam = add_camera()
     bpy.context.view_layer.objects.active = cam
     run_expecting_error(r"'Cam' is a camera, not a mesh")
 
@@ -202,8 +201,7 @@ def test_curve_missing_or_not_a_curve(bunny):
     settings().field_preset = 'ALONG_CURVE'
     run_expecting_error(r"needs a curve\. Pick a curve object", bunny)
     # The panel's picker only offers curves, but a script can set anything.
-    cam = bpy.data.objects.new("Cam", bpy.data.cameras.new("Cam"))
-    bpy.context.collection.objects.link(cam)
+    cam = add_camera()
     bpy.context.scene.exsynth["field_curve"] = cam
     run_expecting_error(r"'Cam' is a camera, not a curve", bunny)
 

@@ -15,7 +15,7 @@ from exsynth.io import bake as bake_io
 from exsynth.io import image as image_io
 from exsynth.io import volume as volume_io
 from exsynth.operators import solid as solid_ops
-from helpers import TEXTURES, cancel_once_running, mesh_state, scene_state
+from helpers import TEXTURES, add_camera, cancel_once_running, mesh_state, scene_state
 
 
 def settings():
@@ -395,8 +395,7 @@ def test_no_mesh_selected(cow, exemplar):
 
 
 def test_only_a_camera_selected(exemplar):
-    cam = bpy.data.objects.new("Cam", bpy.data.cameras.new("Cam"))
-    bpy.context.collection.objects.link(cam)
+    cam = add_camera()
     cam.select_set(True)
     run_expecting_error(r"no mesh selected to bake onto \(selected: 'Cam' \(camera\)\)")
 

@@ -9,6 +9,8 @@ milliseconds.
 import bpy
 import numpy as np
 
+from . import materials
+
 
 def world_triangles(objects, depsgraph):
     """Triangles of the evaluated meshes (modifiers applied) in world space.
@@ -59,6 +61,16 @@ def new_mesh(name, vertices, triangles, smooth=False):
         mesh.polygons.foreach_set("use_smooth", np.ones(n_faces, bool))
     mesh.update(calc_edges=True)
     return mesh
+
+
+def new_surface_object(name, vertices, triangles, collection, created):
+    """A smooth-shaded mesh object with the shared "ExSynth Surface"
+    material, linked into `collection`; everything recorded in `created`."""
+    mesh = created.add(new_mesh(name, vertices, triangles, smooth=True))
+    mesh.materials.append(materials.surface_material(created))
+    obj = created.add(bpy.data.objects.new(mesh.name, mesh))
+    collection.objects.link(obj)
+    return obj
 
 
 def mesh_arrays(mesh):

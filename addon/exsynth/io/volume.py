@@ -10,8 +10,10 @@ folder for an unsaved file (deleted when Blender quits).
 import os
 
 import bpy
+import numpy as np
 
 from .. import _native
+from . import materials
 
 CACHE_FOLDER = "exsynth_cache"
 
@@ -57,6 +59,22 @@ def new_volume_object(name, path, voxel_size, collection, created):
     obj.location = [-blender_cell_offset(voxel_size)] * 3
     collection.objects.link(obj)
     return obj
+
+
+def new_grids_object(name, grids, origin, voxel_size, collection, created):
+    """Named grids written to a new cache file and shown as a Volume object
+    with the shared "ExSynth Volume" material (which reads `density`)."""
+    path = new_cache_path(name)
+    write_vdb(path, grids, origin, voxel_size, created)
+    obj = new_volume_object(name, path, voxel_size, collection, created)
+    obj.data.materials.append(materials.volume_material(created))
+    return obj
+
+
+def sdf_density(sdf, voxel_size):
+    """A density for a signed distance (positive outside): 1 inside, 0
+    outside, a one-voxel ramp, so the density-reading material shows it."""
+    return np.clip(0.5 - sdf / voxel_size, 0.0, 1.0).astype(np.float32)
 
 
 def blender_cell_offset(voxel_size):

@@ -24,7 +24,6 @@ import bpy
 import numpy as np
 
 from .. import _native
-from ..io import materials
 from ..io import mesh as mesh_io
 from ..io import volume as volume_io
 from ..io.selection import select_only
@@ -130,6 +129,10 @@ class Textured:
     @property
     def dims_xyz(self):
         return tuple(reversed(self.b_prime.shape))
+
+    def grids(self):
+        """The grids of B' as written to .vdb: `sdf`, and a `density` for display."""
+        return {"sdf": self.b_prime, "density": volume_io.sdf_density(self.b_prime, self.voxel_size)}
 
 
 @dataclasses.dataclass
@@ -443,22 +446,11 @@ def add_result_objects(context, textured, make_volume, created):
     sdf = B' and density), in the active collection, selected, the mesh active."""
     collection = context.collection
     name = result_name(textured)
-    mesh = created.add(mesh_io.new_mesh(name, *textured.surface, smooth=True))
-    mesh.materials.append(materials.surface_material(created))
-    mesh_obj = created.add(bpy.data.objects.new(mesh.name, mesh))
-    collection.objects.link(mesh_obj)
+    mesh_obj = mesh_io.new_surface_object(name, *textured.surface, collection, created)
     new_objects = [mesh_obj]
     if make_volume:
-        h = textured.voxel_size
-        # A density too (1 inside, 0 outside, a one-voxel ramp), so that the
-        # shared "ExSynth Volume" material (density attribute) shows it.
-        density = np.clip(0.5 - textured.b_prime / h, 0.0, 1.0).astype(np.float32)
-        path = volume_io.new_cache_path(f"{name}_volume")
-        volume_io.write_vdb(path, {"sdf": textured.b_prime, "density": density},
-                            textured.origin, h, created)
-        vol_obj = volume_io.new_volume_object(f"{name}_volume", path, h, collection, created)
-        vol_obj.data.materials.append(materials.volume_material(created))
-        new_objects.append(vol_obj)
+        new_objects.append(volume_io.new_grids_object(f"{name}_volume", textured.grids(), textured.origin,
+                                                      textured.voxel_size, collection, created))
 
     select_only(context.view_layer, new_objects, active=mesh_obj)
     return new_objects

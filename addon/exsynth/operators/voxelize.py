@@ -8,7 +8,6 @@ import bpy
 import numpy as np
 
 from .. import _native
-from ..io import materials
 from ..io import mesh as mesh_io
 from ..io import volume as volume_io
 from ..io.selection import select_only
@@ -89,21 +88,12 @@ def add_voxel_objects(context, voxels, created):
     """Volume object `<name>_voxels` (+ mesh `<name>_voxel_mesh`) in the active
     collection, selected, the Volume active. Returns the new objects."""
     collection = context.collection
-    path = volume_io.new_cache_path(f"{voxels.name}_voxels")
-    volume_io.write_vdb(
-        path, {"density": voxels.density, "sdf": voxels.sdf}, voxels.origin, voxels.voxel_size, created
-    )
-    vol_obj = volume_io.new_volume_object(
-        f"{voxels.name}_voxels", path, voxels.voxel_size, collection, created
-    )
-    vol_obj.data.materials.append(materials.volume_material(created))
+    vol_obj = volume_io.new_grids_object(f"{voxels.name}_voxels", {"density": voxels.density, "sdf": voxels.sdf},
+                                         voxels.origin, voxels.voxel_size, collection, created)
     new_objects = [vol_obj]
     if voxels.surface is not None:
-        mesh = created.add(mesh_io.new_mesh(f"{voxels.name}_voxel_mesh", *voxels.surface, smooth=True))
-        mesh.materials.append(materials.surface_material(created))
-        mesh_obj = created.add(bpy.data.objects.new(mesh.name, mesh))
-        collection.objects.link(mesh_obj)
-        new_objects.append(mesh_obj)
+        new_objects.append(mesh_io.new_surface_object(f"{voxels.name}_voxel_mesh", *voxels.surface, collection,
+                                                      created))
 
     select_only(context.view_layer, new_objects, active=vol_obj)
     return new_objects

@@ -5,7 +5,7 @@ import bpy
 
 from ..operators.analogy import PAIR_MAX, PAIR_MIN, pair_resolution
 from ..operators.field import FIELD_ATTRIBUTE
-from .main import SidebarPanel, draw_shared_advanced
+from .main import SidebarPanel, draw_field_preset, draw_shared_advanced
 
 
 def _is_mesh(obj):
@@ -46,11 +46,7 @@ class EXSYNTH_PT_geometric_texture(SidebarPanel, bpy.types.Panel):
         if _has_field(obj):
             col.label(text=f"Field: '{FIELD_ATTRIBUTE}' of {obj.name}", icon='ORIENTATION_NORMAL')
         if needs_preset:
-            col.prop(settings, "geo_field_preset")
-            if settings.geo_field_preset == 'ALONG_CURVE':
-                col.prop(settings, "geo_field_curve")
-            else:
-                col.row().prop(settings, "geo_field_axis", expand=True)
+            draw_field_preset(col, settings, "geo_field_")
         col.prop(settings, "geo_make_volume")
 
         box = layout.box()

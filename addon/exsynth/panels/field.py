@@ -3,7 +3,7 @@
 
 import bpy
 
-from .main import CATEGORY
+from .main import CATEGORY, draw_field_preset
 
 
 class EXSYNTH_PT_field(bpy.types.Panel):
@@ -24,11 +24,7 @@ class EXSYNTH_PT_field(bpy.types.Panel):
         col = layout.column()
         col.prop(settings, "field_mode")
         if settings.field_mode == 'PRESET':
-            col.prop(settings, "field_preset")
-            if settings.field_preset == 'ALONG_CURVE':
-                col.prop(settings, "field_curve")
-            else:
-                col.row().prop(settings, "field_axis", expand=True)
+            draw_field_preset(col, settings, "field_")
         elif mesh is not None:
             col.prop_search(settings, "field_paint_attribute", mesh, "attributes")
         else:

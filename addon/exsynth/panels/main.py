@@ -22,6 +22,16 @@ class SidebarPanel:
         return layout
 
 
+def draw_field_preset(col, settings, prefix):
+    """A field preset's settings (`<prefix>preset`, then its curve or its
+    axis), as Direction Field and Geometric Texture both ask for them."""
+    col.prop(settings, f"{prefix}preset")
+    if getattr(settings, f"{prefix}preset") == 'ALONG_CURVE':
+        col.prop(settings, f"{prefix}curve")
+    else:
+        col.row().prop(settings, f"{prefix}axis", expand=True)
+
+
 def draw_shared_advanced(layout, settings):
     """Seed and memory budget: scene-wide settings every tool's Advanced panel shows."""
     layout.prop(settings, "seed")
