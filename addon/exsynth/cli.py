@@ -7,8 +7,11 @@ Exit codes: 0 done, 1 the job failed (engine or file error), 2 bad arguments.
 """
 
 import argparse
+import math
 import os
+import signal
 import sys
+import threading
 
 import bpy
 import numpy as np
@@ -17,6 +20,8 @@ from . import _native, jobs
 from .io import bake as bake_io
 from .io import image as image_io
 from .io import mesh as mesh_io
+from .io import mesh_files
+from .io import outputs
 from .io.selection import select_only
 from .operators import analogy as analogy_ops
 from .operators import field as field_ops
@@ -32,7 +37,13 @@ class UsageError(Exception):
     """A bad argument; the message names it."""
 
 
+EXIT_INTERRUPTED = 130  # the shell's code for a run ended by Ctrl-C (128 + SIGINT)
+
+
 def main(argv=None) -> int:
+    """Runs one job; returns the exit code. Each job function returns the
+    line to print on success (the demo: an exit code). Its output files are
+    declared in args.outputs and appear only when the whole job succeeded."""
     parser = _parser()
     try:
         args = parser.parse_args(argv)
@@ -41,14 +52,81 @@ def main(argv=None) -> int:
     if args.job is None:
         parser.print_help(sys.stderr)
         return 2
+    with _ctrl_c_cancels_jobs():
+        try:
+            with outputs.OutputFiles() as args.outputs:
+                done = args.run(args)
+        except (UsageError, outputs.OutputPathError, mesh_files.MeshFileError) as exc:
+            print(f"exsynth {args.job}: error: {exc}", file=sys.stderr)
+            return 2
+        except (KeyboardInterrupt, _native.CancelledError):
+            print(f"exsynth {args.job}: interrupted (Ctrl-C); nothing was written", file=sys.stderr)
+            return EXIT_INTERRUPTED
+        except (jobs.REPORTED_ERRORS + (RuntimeError,)) as exc:  # RuntimeError: a bpy.ops failure
+            print(f"exsynth {args.job}: failed: {exc}; nothing was written", file=sys.stderr)
+            return 1
+    if isinstance(done, str):
+        print(done)
+        return 0
+    return done
+
+
+# ---- running a job: Ctrl-C and progress ------------------------------------------
+class _CtrlC:
+    """SIGINT while a job runs cancels it through its ExecContext (the engine
+    stops at its next chunk); outside a job it raises KeyboardInterrupt. Blender
+    itself only notes the signal ("internal break event") and carries on."""
+
+    runner = None
+    hit = False
+
+    @classmethod
+    def handle(cls, signum, frame):
+        cls.hit = True
+        if cls.runner is not None:
+            cls.runner.cancel()
+        else:
+            raise KeyboardInterrupt
+
+
+class _ctrl_c_cancels_jobs:
+    """Installs _CtrlC.handle for SIGINT (signals reach only the main thread)
+    and puts the previous handler back (the default one when Blender's own C
+    handler was in place, which Python cannot hand back)."""
+
+    def __enter__(self):
+        _CtrlC.hit, _CtrlC.runner = False, None
+        self._installed = threading.current_thread() is threading.main_thread()
+        if self._installed:
+            self._previous = signal.signal(signal.SIGINT, _CtrlC.handle)
+
+    def __exit__(self, *exc):
+        if self._installed:
+            signal.signal(signal.SIGINT, self._previous if self._previous is not None else signal.SIG_DFL)
+        return False
+
+
+def _run_job(job, label):
+    """Runs `job` on a worker thread while this (main) thread waits, so that
+    the SIGINT handler can run; prints each new stage to stderr. Returns the
+    job's result (raises its error, CancelledError after Ctrl-C)."""
+    runner = jobs.Runner(job)
+    _CtrlC.runner = runner
     try:
-        return args.run(args)
-    except UsageError as exc:
-        print(f"exsynth {args.job}: error: {exc}", file=sys.stderr)
-        return 2
-    except (jobs.REPORTED_ERRORS + (RuntimeError,)) as exc:  # RuntimeError: a bpy.ops failure
-        print(f"exsynth {args.job}: failed: {exc}", file=sys.stderr)
-        return 1
+        runner.start()
+        shown = None
+        while runner.running:
+            runner.join(0.05)
+            stage, pct = runner.status()
+            if stage != shown and runner.running:
+                print(f"exsynth {label}: {stage} ({pct}%)", file=sys.stderr, flush=True)
+                shown = stage
+    finally:
+        runner.join()
+        _CtrlC.runner = None
+    if _CtrlC.hit:
+        raise KeyboardInterrupt
+    return runner.outcome(), runner.seconds
 
 
 def _parser():
@@ -64,15 +142,15 @@ def _parser():
     p.add_argument("--mesh", required=True, help="input mesh: .obj, .ply or .stl")
     p.add_argument("--out", required=True,
                    help=".vdb (grids density and sdf) or .npy ((Z, Y, X, 2) float32: density, sdf)")
-    p.add_argument("--resolution", type=int, default=128,
+    p.add_argument("--resolution", type=_int, default=128,
                    help="voxels along the longest bounding-box side (default 128)")
-    p.add_argument("--voxel-size", type=float, default=0.0,
+    p.add_argument("--voxel-size", type=_finite, default=0.0,
                    help="voxel edge length in mesh units; overrides --resolution when > 0")
-    p.add_argument("--padding", type=int, default=2, help="empty voxels on every side (default 2)")
-    p.add_argument("--supersample", type=int, default=2, help="sub-rays per voxel edge, 1..8 (default 2)")
+    p.add_argument("--padding", type=_int, default=2, help="empty voxels on every side (default 2)")
+    p.add_argument("--supersample", type=_int, default=2, help="sub-rays per voxel edge, 1..8 (default 2)")
     p.add_argument("--mesh-out", help="also write the rebuilt surface (zero level of the sdf) as .obj")
-    p.add_argument("--seed", type=int, default=0, help="random seed (default 0)")
-    p.add_argument("--memory-budget", type=float, default=0.0,
+    p.add_argument("--seed", type=_seed, default=0, help="random seed (default 0)")
+    p.add_argument("--memory-budget", type=_gib, default=0.0,
                    help="refuse jobs needing more than this many GiB (default: the engine's 8 GiB)")
     p.set_defaults(run=_run_voxelize)
 
@@ -84,22 +162,22 @@ def _parser():
     p.add_argument("--exemplar", required=True, help="exemplar image (any format Blender reads)")
     p.add_argument("--exemplar-y", help="exemplar of the slices across Y (default: --exemplar)")
     p.add_argument("--exemplar-z", help="exemplar of the slices across Z (default: --exemplar)")
-    p.add_argument("--size", type=int, default=64, help="voxels along each edge of the solid (default 64)")
+    p.add_argument("--size", type=_int, default=64, help="voxels along each edge of the solid (default 64)")
     p.add_argument("--out", required=True,
                    help=".vdb (grid color, + alpha with --alpha) or .npy ((Z, Y, X, C) float32)")
-    p.add_argument("--levels", type=int, default=3, help="coarse-to-fine levels (default 3)")
-    p.add_argument("--iterations", type=int, default=3, help="optimisation rounds per level (default 3)")
-    p.add_argument("--seed", type=int, default=0, help="random seed (default 0)")
+    p.add_argument("--levels", type=_int, default=3, help="coarse-to-fine levels (default 3)")
+    p.add_argument("--iterations", type=_int, default=3, help="optimisation rounds per level (default 3)")
+    p.add_argument("--seed", type=_seed, default=0, help="random seed (default 0)")
     p.add_argument("--alpha", action="store_true", help="synthesize the exemplars' alpha as a 4th channel")
-    p.add_argument("--scale", type=float, default=0.0,
+    p.add_argument("--scale", type=_finite, default=0.0,
                    help="edge length of one tile in mesh units (default: the mesh's longest side, "
                    "or 1 without --mesh); sets the .vdb's voxel size")
     p.add_argument("--mesh", help="also bake the solid onto this mesh (.obj, .ply, .stl; unwrapped with "
                    "Smart UV Project when it has no UVs)")
     p.add_argument("--bake-out", help="the baked texture (.png), with --mesh")
-    p.add_argument("--bake-size", type=int, default=512, help="baked texture width and height (default 512)")
+    p.add_argument("--bake-size", type=_int, default=512, help="baked texture width and height (default 512)")
     p.add_argument("--mesh-out", help="with --mesh: write the mesh with the UV map the bake used (.obj)")
-    p.add_argument("--memory-budget", type=float, default=0.0,
+    p.add_argument("--memory-budget", type=_gib, default=0.0,
                    help="refuse jobs needing more than this many GiB (default: the engine's 8 GiB)")
     p.set_defaults(run=_run_solid)
 
@@ -108,15 +186,15 @@ def _parser():
         description="2D texture synthesis with the solid engine's optimiser.",
     )
     p.add_argument("--exemplar", required=True, help="exemplar image (any format Blender reads)")
-    p.add_argument("--width", type=int, required=True, help="output width in pixels")
-    p.add_argument("--height", type=int, required=True, help="output height in pixels")
+    p.add_argument("--width", type=_int, required=True, help="output width in pixels")
+    p.add_argument("--height", type=_int, required=True, help="output height in pixels")
     p.add_argument("--out", required=True, help="output image (.png)")
     p.add_argument("--tileable", action="store_true", help="make the output tile (opposite edges continue)")
-    p.add_argument("--levels", type=int, default=3, help="coarse-to-fine levels (default 3)")
-    p.add_argument("--iterations", type=int, default=3, help="optimisation rounds per level (default 3)")
-    p.add_argument("--seed", type=int, default=0, help="random seed (default 0)")
+    p.add_argument("--levels", type=_int, default=3, help="coarse-to-fine levels (default 3)")
+    p.add_argument("--iterations", type=_int, default=3, help="optimisation rounds per level (default 3)")
+    p.add_argument("--seed", type=_seed, default=0, help="random seed (default 0)")
     p.add_argument("--alpha", action="store_true", help="synthesize the exemplar's alpha too")
-    p.add_argument("--memory-budget", type=float, default=0.0,
+    p.add_argument("--memory-budget", type=_gib, default=0.0,
                    help="refuse jobs needing more than this many GiB (default: the engine's 8 GiB)")
     p.set_defaults(run=_run_image)
 
@@ -155,22 +233,22 @@ def _parser():
                    help="the direction field the pattern follows (default around_axis)")
     p.add_argument("--field", help="B's own field: .npy, one direction per vertex of --b (V by 3, e.g. from "
                    "'run field', painted and diffused); wins over --field-preset for B (A keeps the preset)")
-    p.add_argument("--axis", type=float, nargs=3, metavar=("X", "Y", "Z"), default=(0.0, 0.0, 1.0),
+    p.add_argument("--axis", type=_finite, nargs=3, metavar=("X", "Y", "Z"), default=(0.0, 0.0, 1.0),
                    help="around_axis / along_axis: the axis in the files' coordinates (default 0 0 1)")
     p.add_argument("--curve", help="along_curve: the curve as a polyline, .obj (vertices joined by "
                    "'l' lines) or .npy (N by 3), in the files' coordinates")
-    p.add_argument("--resolution", type=int, default=128,
+    p.add_argument("--resolution", type=_int, default=128,
                    help="voxels along B's longest bounding-box side (default 128)")
-    p.add_argument("--pattern-size", type=float, default=0.5,
+    p.add_argument("--pattern-size", type=_finite, default=0.5,
                    help="built-in pairs: the pair's cube as a fraction of B's longest side (default 0.5); "
                    "the pair is made at resolution x pattern size voxels (8..512)")
     p.add_argument("--out", required=True,
                    help=".obj (B''s isosurface), .vdb (grids sdf and density) or .npy ((Z, Y, X) float32 "
                    "signed distance of B', positive outside)")
-    p.add_argument("--dilation", type=float, default=0.15, help="dilate: A' radius minus A's (default 0.15)")
-    p.add_argument("--spike-height", type=float, default=0.3, help="spikes: cone height (default 0.3)")
-    p.add_argument("--seed", type=int, default=0, help="random seed (default 0)")
-    p.add_argument("--memory-budget", type=float, default=0.0,
+    p.add_argument("--dilation", type=_finite, default=0.15, help="dilate: A' radius minus A's (default 0.15)")
+    p.add_argument("--spike-height", type=_finite, default=0.3, help="spikes: cone height (default 0.3)")
+    p.add_argument("--seed", type=_seed, default=0, help="random seed (default 0)")
+    p.add_argument("--memory-budget", type=_gib, default=0.0,
                    help="refuse jobs needing more than this many GiB (default: the engine's 8 GiB)")
     p.set_defaults(run=_run_analogy)
 
@@ -181,9 +259,9 @@ def _parser():
                        "with Cycles.")
     p.add_argument("--assets", required=True, help="the repository's assets/ folder")
     p.add_argument("--out", required=True, help="folder for the PNGs")
-    p.add_argument("--resolution", type=int, default=96, help="voxels along the longest side (default 96)")
-    p.add_argument("--samples", type=int, default=16, help="Cycles samples per pixel (default 16)")
-    p.add_argument("--solid-size", type=int, default=64, help="voxels along the solid's edge (default 64)")
+    p.add_argument("--resolution", type=_int, default=96, help="voxels along the longest side (default 96)")
+    p.add_argument("--samples", type=_int, default=16, help="Cycles samples per pixel (default 16)")
+    p.add_argument("--solid-size", type=_int, default=64, help="voxels along the solid's edge (default 64)")
     p.set_defaults(run=_run_demo)
     return parser
 
@@ -191,9 +269,8 @@ def _parser():
 # ---- voxelize ----------------------------------------------------------------
 def _run_voxelize(args):
     mesh_path = _input_file("--mesh", args.mesh, MESH_FORMATS)
-    out_ext = _extension("--out", args.out, VOXEL_FORMATS)
-    if args.mesh_out:
-        _extension("--mesh-out", args.mesh_out, (".obj",))
+    out = args.outputs.add("--out", args.out, VOXEL_FORMATS)
+    mesh_out = args.outputs.add("--mesh-out", args.mesh_out, (".obj",)) if args.mesh_out else None
     _require(args.resolution > 0, f"--resolution must be > 0 (got {args.resolution})")
     _require(args.voxel_size >= 0, f"--voxel-size must be >= 0 (got {args.voxel_size}); 0 uses --resolution")
     _require(args.padding >= 0, f"--padding must be >= 0 (got {args.padding})")
@@ -209,31 +286,28 @@ def _run_voxelize(args):
         supersample=args.supersample, make_mesh=bool(args.mesh_out),
         memory_budget=int(args.memory_budget * GIB), seed=args.seed,
     )
-    runner = jobs.Runner(job)
-    runner.run_here()
-    voxels = runner.outcome()
+    voxels, seconds = _run_job(job, "voxelize")
+    if voxels.warning():
+        print(f"exsynth voxelize: warning: {voxels.warning()}", file=sys.stderr)
 
-    _make_parent(args.out)
-    if out_ext == ".vdb":
-        _native.write_vdb(args.out, {"density": voxels.density, "sdf": voxels.sdf},
-                          voxels.origin, voxels.voxel_size)
+    if out.endswith(".vdb"):
+        _native.write_vdb(out, {"density": voxels.density, "sdf": voxels.sdf}, voxels.origin, voxels.voxel_size)
     else:
-        np.save(args.out, np.stack([voxels.density, voxels.sdf], axis=-1).astype(np.float32))
+        np.save(out, np.stack([voxels.density, voxels.sdf], axis=-1).astype(np.float32))
     nx, ny, nz = voxels.dims_xyz
     line = (f"voxelize: {nx}x{ny}x{nz} voxels of {voxels.voxel_size:.6g} "
-            f"from {len(tris)} triangles in {runner.seconds:.2f} s -> {args.out}")
-    if args.mesh_out:
-        _make_parent(args.mesh_out)
-        export_obj(args.mesh_out, f"{job.name}_voxel_mesh", *voxels.surface)
+            f"from {len(tris)} triangles in {seconds:.2f} s -> {args.out}")
+    if mesh_out:
+        export_obj(mesh_out, f"{job.name}_voxel_mesh", *voxels.surface)
         line += f", {len(voxels.surface[1])} triangles -> {args.mesh_out}"
-    print(line)
-    return 0
+    return line
 
 
 # ---- analogy -----------------------------------------------------------------
 def _run_analogy(args):
     b_path = _input_file("--b", args.b, MESH_FORMATS)
-    out_ext = _extension("--out", args.out, (".obj",) + VOXEL_FORMATS)
+    out = args.outputs.add("--out", args.out, (".obj",) + VOXEL_FORMATS)
+    out_ext = os.path.splitext(out)[1]
     _require(args.resolution > 0, f"--resolution must be > 0 (got {args.resolution})")
     _require(args.memory_budget >= 0, f"--memory-budget must be >= 0 GiB (got {args.memory_budget})")
     _require(bool(args.a) == bool(args.a_prime),
@@ -243,11 +317,11 @@ def _run_analogy(args):
              "--field-preset along_curve needs --curve CURVE.obj (or .npy)")
     _require(not args.curve or args.field_preset == "along_curve", "--curve goes with --field-preset along_curve")
     _require(any(args.axis), "--axis must not be 0 0 0: give the axis direction, e.g. --axis 0 0 1")
-    _require(all(np.isfinite(args.axis)), f"--axis must be finite numbers (got {' '.join(map(str, args.axis))})")
     if args.preset:
         _require(args.pattern_size > 0, f"--pattern-size must be > 0 (got {args.pattern_size})")
         try:
-            analogy_ops.check_settings(args.preset, args.resolution, args.pattern_size)
+            analogy_ops.check_settings(args.preset, args.resolution, args.pattern_size, _pair_options(args),
+                                       names={"feature_height": "--spike-height", "dilation": "--dilation"})
         except jobs.InputError as exc:
             raise UsageError(str(exc).replace("Pattern Size", "--pattern-size").replace("Resolution", "--resolution"))
     else:
@@ -264,8 +338,7 @@ def _run_analogy(args):
         b.field = _vertex_field(args.field, b.vertices)
     job = analogy_ops.GeometricTextureJob(
         b=b, preset=args.preset or "spikes", resolution=args.resolution, pattern_scale=args.pattern_size,
-        pair_options={"dilate": {"dilation": args.dilation},
-                      "spikes": {"feature_height": args.spike_height}}.get(args.preset, {}),
+        pair_options=_pair_options(args),
         memory_budget=int(args.memory_budget * GIB), seed=args.seed,
     )
     if not args.preset:
@@ -280,25 +353,27 @@ def _run_analogy(args):
             analogy_ops.check_user_pair_grid(b.vertices, job.a.vertices, job.a_prime.vertices, args.resolution)
         except jobs.InputError as exc:
             raise UsageError(f"--a/--a-prime: {str(exc).replace('Resolution', '--resolution')}")
-    runner = jobs.Runner(job)
-    runner.run_here()
-    result = runner.outcome()
+    result, seconds = _run_job(job, "analogy")
 
-    _make_parent(args.out)
     if out_ext == ".obj":
-        export_obj(args.out, analogy_ops.result_name(result), *result.surface)
+        export_obj(out, analogy_ops.result_name(result), *result.surface)
     elif out_ext == ".vdb":
-        _native.write_vdb(args.out, result.grids(), result.origin, result.voxel_size)
+        _native.write_vdb(out, result.grids(), result.origin, result.voxel_size)
     else:
-        np.save(args.out, np.ascontiguousarray(result.b_prime, np.float32))
+        np.save(out, np.ascontiguousarray(result.b_prime, np.float32))
     nx, ny, nz = result.dims_xyz
     px, py, pz = result.pair_dims
     stats = result.stats
-    print(f"analogy: {result.pair} on {os.path.basename(b_path)}, {nx}x{ny}x{nz} voxels of "
-          f"{result.voxel_size:.6g}, pair {px}x{py}x{pz}, field {result.field}; searched {stats['searched']}, "
-          f"coherent {stats['coherent']}, culled {stats['culled']}, debris {stats['debris']}; "
-          f"{len(result.surface[1])} triangles in {runner.seconds:.2f} s -> {args.out}")
-    return 0
+    return (f"analogy: {result.pair} on {os.path.basename(b_path)}, {nx}x{ny}x{nz} voxels of "
+            f"{result.voxel_size:.6g}, pair {px}x{py}x{pz}, field {result.field}; searched {stats['searched']}, "
+            f"coherent {stats['coherent']}, culled {stats['culled']}, debris {stats['debris']}; "
+            f"{len(result.surface[1])} triangles in {seconds:.2f} s -> {args.out}")
+
+
+def _pair_options(args):
+    """The built-in pair's shape options the CLI sets (as operators.analogy.pair_options)."""
+    return {"dilate": {"dilation": args.dilation},
+            "spikes": {"feature_height": args.spike_height}}.get(args.preset, {})
 
 
 def _analogy_mesh(arg, path, field):
@@ -307,6 +382,10 @@ def _analogy_mesh(arg, path, field):
     verts, tris = mesh_io.world_triangles(objects, bpy.context.evaluated_depsgraph_get())
     if len(tris) == 0:
         raise UsageError(f"{arg}: {path} has no faces (the analogy works on solids: give a closed mesh)")
+    try:
+        _native.validate_mesh(verts, tris, f"{arg} {os.path.basename(path)}")
+    except _native.InvalidInputError as exc:
+        raise UsageError(str(exc)) from None
     name = os.path.splitext(os.path.basename(path))[0]
     return analogy_ops.MeshInput(name=name, vertices=verts, triangles=tris, field=field)
 
@@ -384,7 +463,7 @@ def _polyline(mesh):
 
 # ---- solid and image ----------------------------------------------------------------
 def _run_solid(args):
-    out_ext = _extension("--out", args.out, VOXEL_FORMATS)
+    out = args.outputs.add("--out", args.out, VOXEL_FORMATS)
     paths = [_input_file("--exemplar", args.exemplar, None)]
     for arg, path in (("--exemplar-y", args.exemplar_y), ("--exemplar-z", args.exemplar_z)):
         paths.append(_input_file(arg, path, None) if path else None)
@@ -397,10 +476,9 @@ def _run_solid(args):
     _require(not args.mesh_out or args.mesh, "--mesh-out needs --mesh")
     if args.mesh:
         mesh_path = _input_file("--mesh", args.mesh, MESH_FORMATS)
-        _extension("--bake-out", args.bake_out, (".png",))
+        bake_out = args.outputs.add("--bake-out", args.bake_out, (".png",))
         _require(args.bake_size > 0, f"--bake-size must be > 0 (got {args.bake_size})")
-    if args.mesh_out:
-        _extension("--mesh-out", args.mesh_out, (".obj",))
+    mesh_out = args.outputs.add("--mesh-out", args.mesh_out, (".obj",)) if args.mesh_out else None
 
     images = [image_io.load(p) if p else None for p in paths]
     exemplar, exemplar_y, exemplar_z, encoding = solid_ops.read_exemplars(*images, use_alpha=args.alpha)
@@ -416,37 +494,31 @@ def _run_solid(args):
         scale=scale, seed=args.seed, memory_budget=int(args.memory_budget * GIB), encoding=encoding,
         anchor=anchor, targets=targets, bake=solid_ops.BakeOptions(args.bake_size),
     )
-    runner = jobs.Runner(job)
-    runner.run_here()
-    result = runner.outcome()
+    result, seconds = _run_job(job, "solid")
     solid = result.solid
 
-    _make_parent(args.out)
-    if out_ext == ".vdb":
-        _native.write_vdb(args.out, solid_ops.solid_grids(solid.values), solid.origin, solid.voxel_size)
+    if out.endswith(".vdb"):
+        _native.write_vdb(out, solid_ops.solid_grids(solid.values), solid.origin, solid.voxel_size)
     else:
-        np.save(args.out, np.ascontiguousarray(solid.values, np.float32))
+        np.save(out, np.ascontiguousarray(solid.values, np.float32))
     n, c = solid.size, solid.values.shape[3]
     energy = f", final energy {solid.energy[-1]:.4g}" if solid.energy else ""
     line = (f"solid: {n}x{n}x{n} voxels x {c} channels of {solid.voxel_size:.6g} from "
-            f"{os.path.basename(paths[0])} in {runner.seconds:.2f} s{energy} -> {args.out}")
+            f"{os.path.basename(paths[0])} in {seconds:.2f} s{energy} -> {args.out}")
     if args.mesh:
         baked = result.baked[0]
-        _make_parent(args.bake_out)
-        image_io.save_png(args.bake_out, baked.pixels, encoding)
+        image_io.save_png(bake_out, baked.pixels, encoding)
         line += f", {args.bake_size}² texture ({100 * baked.covered:.0f} % covered) -> {args.bake_out}"
-        if args.mesh_out:
+        if mesh_out:
             bake_io.apply_uvs(obj, baked.target, jobs.Created())
-            _make_parent(args.mesh_out)
-            export_selected_obj(args.mesh_out, obj, uvs=True)
+            export_selected_obj(mesh_out, obj, uvs=True)
             line += f", mesh -> {args.mesh_out}"
-    print(line)
-    return 0
+    return line
 
 
 def _run_image(args):
     exemplar_path = _input_file("--exemplar", args.exemplar, None)
-    _extension("--out", args.out, (".png",))
+    out = args.outputs.add("--out", args.out, (".png",))
     _require(args.width > 0 and args.height > 0,
              f"--width and --height must be > 0 (got {args.width}x{args.height})")
     _require(args.levels > 0, f"--levels must be > 0 (got {args.levels})")
@@ -460,15 +532,11 @@ def _run_image(args):
         levels=args.levels, iterations=args.iterations, seed=args.seed,
         memory_budget=int(args.memory_budget * GIB),
     )
-    runner = jobs.Runner(job)
-    runner.run_here()
-    pixels = runner.outcome()
-    _make_parent(args.out)
-    image_io.save_png(args.out, pixels[::-1], encoding)  # the engine's row 0 is the top
+    pixels, seconds = _run_job(job, "image")
+    image_io.save_png(out, pixels[::-1], encoding)  # the engine's row 0 is the top
     tile = ", tileable" if args.tileable else ""
-    print(f"image: {args.width}x{args.height}{tile} from {os.path.basename(exemplar_path)} "
-          f"in {runner.seconds:.2f} s -> {args.out}")
-    return 0
+    return (f"image: {args.width}x{args.height}{tile} from {os.path.basename(exemplar_path)} "
+            f"in {seconds:.2f} s -> {args.out}")
 
 
 def _single_mesh(objects, path):
@@ -501,11 +569,9 @@ def import_mesh(path):
 
 
 def export_obj(path, name, vertices, triangles):
-    """Write (vertices, triangles) as OBJ through Blender's exporter, in the
-    same (unconverted) axes the input was read in."""
-    obj = bpy.data.objects.new(name, mesh_io.new_mesh(name, vertices, triangles))
-    bpy.context.scene.collection.objects.link(obj)
-    export_selected_obj(path, obj)
+    """Write (vertices, triangles) as OBJ in the same (unconverted) axes the
+    input was read in (see mesh_files.write_obj for why not Blender's exporter)."""
+    mesh_files.write_obj(path, name, vertices, triangles)
 
 
 def export_selected_obj(path, obj, uvs=False):
@@ -525,32 +591,34 @@ def _enable_bundled_addon(name):
 # ---- field ---------------------------------------------------------------------
 def _run_field(args):
     mesh_path = _input_file("--mesh", args.mesh, (".obj", ".ply"))
-    _extension("--out", args.out, (".npy",))
+    out = args.outputs.add("--out", args.out, (".npy",))
     _require(args.preset != "along_curve" or args.curve, "--preset along_curve needs --curve CURVE.npy")
     _require(not args.curve or args.preset == "along_curve", "--curve goes with --preset along_curve")
     paint = _load_npy("--paint", args.paint) if args.paint else None
     curve = _load_npy("--curve", args.curve) if args.curve else None
 
-    objects = import_mesh(mesh_path)
-    _require(len(objects) == 1, f"--mesh: {mesh_path} holds {len(objects)} meshes; the field needs exactly one")
-    verts, tris = mesh_io.mesh_arrays(objects[0].data)
+    if mesh_path.lower().endswith(".obj"):  # read here: Blender's importer drops loose vertices
+        verts, tris = mesh_files.read_obj("--mesh", mesh_path)
+    else:
+        objects = import_mesh(mesh_path)
+        _require(len(objects) == 1, f"--mesh: {mesh_path} holds {len(objects)} meshes; the field needs exactly one")
+        verts, tris = mesh_io.mesh_arrays(objects[0].data)
     if len(tris) == 0:
         raise UsageError(f"--mesh: {mesh_path} has no faces to put a field on")
     if paint is not None:
         _require(paint.shape == verts.shape,
                  f"--paint: {args.paint} is {paint.shape}, the mesh needs ({len(verts)}, 3): one vector per vertex")
+        bad = np.flatnonzero(~np.isfinite(paint).all(axis=1))
+        _require(len(bad) == 0, f"--paint: row {bad[0] if len(bad) else 0} of {args.paint} is not finite (NaN or "
+                 "Inf); use a zero vector where the direction is free")
     job = field_ops.FieldJob(
         vertices=verts, triangles=tris, preset=args.preset or "around_axis",
         axis=field_ops.AXES[args.axis.upper()], curve=curve, given=paint,
     )
-    runner = jobs.Runner(job)
-    runner.run_here()
-    field = runner.outcome()
-    _make_parent(args.out)
-    np.save(args.out, np.ascontiguousarray(field, np.float32))
+    field, seconds = _run_job(job, "field")
+    np.save(out, np.ascontiguousarray(field, np.float32))
     how = f"diffused from {os.path.basename(args.paint)}" if paint is not None else args.preset
-    print(f"field: {len(field)} vertices, {how}, in {runner.seconds:.2f} s -> {args.out}")
-    return 0
+    return f"field: {len(field)} vertices, {how}, in {seconds:.2f} s -> {args.out}"
 
 
 def _load_npy(arg, path):
@@ -578,6 +646,51 @@ def _run_demo(args):
 
 
 # ---- argument checks ----------------------------------------------------------
+# argparse types: a bad value is refused before anything runs, as
+# "argument --seed: ...", with the valid range.
+MAX_GIB = 1 << 20  # 1 PiB: any budget a machine can have
+
+
+def _seed(text):
+    try:
+        value = int(text, 0)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"'{text}' is not a whole number; give 0 .. 2**64-1") from None
+    if not 0 <= value < 1 << 64:
+        raise argparse.ArgumentTypeError(f"{value} is out of range; give 0 .. 2**64-1")
+    return value
+
+
+def _int(text):
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"'{text}' is not a whole number") from None
+    if abs(value) >= 1 << 31:
+        raise argparse.ArgumentTypeError(f"{value} is far too large (the limit is 2**31-1)")
+    return value
+
+
+def _finite(text):
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"'{text}' is not a number") from None
+    if not math.isfinite(value):
+        raise argparse.ArgumentTypeError(f"{text} is not a finite number")
+    return value
+
+
+def _gib(text):
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"'{text}' is not a number of GiB") from None
+    if not (math.isfinite(value) and 0 <= value <= MAX_GIB):
+        raise argparse.ArgumentTypeError(f"{text} GiB is out of range; give 0 (the engine's default) .. {MAX_GIB}")
+    return value
+
+
 def _require(ok, message):
     if not ok:
         raise UsageError(message)
@@ -592,12 +705,10 @@ def _extension(arg, path, allowed):
 def _input_file(arg, path, allowed):
     """An existing file; `allowed` extensions (None: any, e.g. images Blender reads)."""
     path = os.path.abspath(path)
+    _require(not os.path.isdir(path), f"{arg}: {path} is a folder; give a file in it")
     _require(os.path.isfile(path), f"{arg}: no such file: {path}")
     if allowed is not None:
         _extension(arg, path, allowed)
+    mesh_files.check_indices(arg, path)  # what Blender's importers would drop silently
     return path
 
-
-def _make_parent(path):
-    parent = os.path.dirname(os.path.abspath(path))
-    os.makedirs(parent, exist_ok=True)

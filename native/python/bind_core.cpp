@@ -15,6 +15,7 @@ PyObject* g_error = nullptr;
 PyObject* g_invalid = nullptr;
 PyObject* g_budget = nullptr;
 PyObject* g_cancelled = nullptr;
+PyObject* g_io = nullptr;
 
 PyObject* new_exception(py::module_& m, const char* name, py::handle bases, const char* doc) {
   const std::string qualified = std::string("exsynth._native.") + name;
@@ -33,6 +34,8 @@ void bind_core(py::module_& m) {
   g_budget = new_exception(m, "OverBudgetError", py::make_tuple(py::handle(g_error), py::handle(PyExc_MemoryError)),
                            "The job would need more memory than its budget (checked before allocating).");
   g_cancelled = new_exception(m, "CancelledError", py::handle(g_error), "The job was cancelled through its ExecContext.");
+  g_io = new_exception(m, "IoError", py::make_tuple(py::handle(g_error), py::handle(PyExc_OSError)),
+                       "A file cannot be read or written; the message names it and says why.");
 
   // One C++ class -> one Python class; nothing is swallowed.
   py::register_exception_translator([](std::exception_ptr p) {
@@ -44,6 +47,8 @@ void bind_core(py::module_& m) {
       PyErr_SetString(g_budget, e.what());
     } catch (const Cancelled& e) {
       PyErr_SetString(g_cancelled, e.what());
+    } catch (const IoError& e) {
+      PyErr_SetString(g_io, e.what());
     } catch (const Error& e) {
       PyErr_SetString(g_error, e.what());
     }

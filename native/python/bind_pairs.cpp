@@ -65,6 +65,18 @@ void apply_options(PairOptions& o, const py::kwargs& kw) {
 
 void bind_pairs(py::module_& m) {
   m.def(
+      "check_exemplar_pair",
+      [](const std::string& preset, int resolution, const py::kwargs& kw) {
+        PairOptions opt;
+        opt.resolution = resolution;
+        apply_options(opt, kw);
+        validate_pair_options(to_preset(preset), opt);
+      },
+      py::arg("preset") = "spikes", py::kw_only(), py::arg("resolution") = 64,
+      R"doc(Raise InvalidInputError if make_exemplar_pair would refuse these options (same
+arguments, nothing built): lets a caller refuse a job before it starts.)doc");
+
+  m.def(
       "make_exemplar_pair",
       [](const std::string& preset, int resolution, std::uint64_t seed, ExecContext* ctx, const py::kwargs& kw) {
         PairOptions opt;

@@ -135,6 +135,19 @@ TEST(Isosurface, SphereSdf) {
   EXPECT_DOUBLE_EQ(ctx.progress(), 1.0);
 }
 
+TEST(Isosurface, TinyVoxelsWork) {
+  // A model a millionth of a unit across: OpenVDB refuses such scales in a
+  // transform, so meshing runs in index space. Same shape as SphereSdf, scaled.
+  const double s = 1e-6, h = 0.1 * s, r = 1.5 * s;
+  Volume sdf = sphere_volume(48, h, r, {0.3 * s, 0, 0}, {0.3 * s, 0, 0}, [](double d) { return d; });
+  TriangleMesh m = exsynth::isosurface(sdf);
+  ASSERT_FALSE(m.faces.empty());
+  EXPECT_TRUE(is_closed_and_oriented(m));
+  for (const auto& v : m.vertices) ASSERT_NEAR((v.cast<double>() - Eigen::Vector3d(0.3 * s, 0, 0)).norm(), r, 0.5 * h);
+  const double want = 4.0 / 3.0 * kPi * r * r * r;
+  EXPECT_NEAR(exsynth::enclosed_volume(m), want, 0.03 * want);
+}
+
 TEST(Isosurface, InvertedDensityIsOrientedOutwards) {
   const double h = 0.1, r = 1.2;
   // A smooth density: 1 inside, 0 outside, 0.5 on the sphere.

@@ -170,11 +170,31 @@ TEST_F(VdbIo, MissingFileIsNamed) {
   const std::string path = file("nope.vdb");
   try {
     exsynth::read_vdb(path);
-    FAIL() << "expected InvalidInput";
-  } catch (const exsynth::InvalidInput& e) {
+    FAIL() << "expected IoError";
+  } catch (const exsynth::IoError& e) {
     EXPECT_TRUE(contains(e.what(), path)) << e.what();
     EXPECT_TRUE(contains(e.what(), "not found")) << e.what();
   }
+}
+
+TEST_F(VdbIo, VoxelsTooSmallForOpenVdbAreRefusedByName) {
+  Volume v = filled(2, 2, 2, 1, 1.0f);
+  GridTransform t;
+  t.voxel_size = 1e-8;
+  v.set_transform(t);
+  try {
+    exsynth::write_vdb(file("tiny.vdb"), {{"density", v}});
+    FAIL() << "expected InvalidInput";
+  } catch (const exsynth::InvalidInput& e) {
+    EXPECT_TRUE(contains(e.what(), "voxel size 1e-08 is too small")) << e.what();
+    EXPECT_TRUE(contains(e.what(), "scale the model up")) << e.what();
+  }
+  EXPECT_FALSE(std::filesystem::exists(file("tiny.vdb")));
+}
+
+TEST_F(VdbIo, UnwritablePathIsAnIoError) {
+  // A folder cannot be written as a file: an I/O error (OSError in Python), not bad input.
+  EXPECT_THROW(exsynth::write_vdb(dir_.string(), {{"density", filled(2, 2, 2, 1, 1.0f)}}), exsynth::IoError);
 }
 
 TEST_F(VdbIo, MissingGridIsNamedWithTheGridsPresent) {
@@ -235,21 +255,21 @@ TEST_F(VdbIo, TransformsThatDoNotFitOneBoxAreRejected) {
   EXPECT_EQ(exsynth::read_vdb(file("mixed.vdb"), {"b"}).at("b").transform().voxel_size, 0.2);
 }
 
-TEST_F(VdbIo, NonVdbFileIsInvalidInput) {
+TEST_F(VdbIo, NonVdbFileIsAnIoError) {
   {
     std::FILE* fp = std::fopen(file("junk.vdb").c_str(), "w");
     ASSERT_TRUE(fp);
     std::fputs("not a vdb file", fp);
     std::fclose(fp);
   }
-  EXPECT_THROW(exsynth::read_vdb(file("junk.vdb")), exsynth::InvalidInput);
+  EXPECT_THROW(exsynth::read_vdb(file("junk.vdb")), exsynth::IoError);
 }
 
 TEST_F(VdbIo, WriteRejectsBadInput) {
   EXPECT_THROW(exsynth::write_vdb(file("e.vdb"), {}), exsynth::InvalidInput);
   EXPECT_THROW(exsynth::write_vdb(file("e.vdb"), {{"density", Volume()}}), exsynth::InvalidInput);
   EXPECT_THROW(exsynth::write_vdb(file("no_such_dir/e.vdb"), {{"d", filled(2, 2, 2, 1, 1.0f)}}),
-               exsynth::InvalidInput);
+               exsynth::IoError);  // a missing folder: an I/O error
   // "c" (2 channels) becomes c_0, c_1 and would clash with "c_0".
   EXPECT_THROW(exsynth::write_vdb(file("e.vdb"),
                                   {{"c", filled(2, 2, 2, 2, 1.0f)}, {"c_0", filled(2, 2, 2, 1, 1.0f)}}),

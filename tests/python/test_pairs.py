@@ -86,3 +86,20 @@ def test_bad_input_is_rejected_with_a_message_naming_it(kwargs, exc, words):
         _native.make_exemplar_pair(preset, **kwargs)
     for w in words:
         assert w in str(info.value)
+
+
+@pytest.mark.parametrize("preset, options, message", [
+    ("dilate", {"dilation": -5.0}, "dilation must be a finite number > 0, got -5"),
+    ("spikes", {"feature_height": 5.0}, r"feature_height \(5\) plus half the thickness"),
+    ("pits", {"feature_radius": 0.45}, "feature_radius"),
+])
+def test_check_exemplar_pair_refuses_what_make_would(preset, options, message):
+    with pytest.raises(_native.InvalidInputError, match=message):
+        _native.check_exemplar_pair(preset, **options)
+    with pytest.raises(_native.InvalidInputError, match=message):
+        _native.make_exemplar_pair(preset, resolution=16, **options)
+
+
+def test_check_exemplar_pair_accepts_the_defaults():
+    for preset in ("spikes", "pits", "holes", "grooves", "dilate"):
+        assert _native.check_exemplar_pair(preset) is None

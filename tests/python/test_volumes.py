@@ -51,7 +51,7 @@ def test_write_vdb_rejects_bad_transform(tmp_path):
 
 
 def test_read_vdb_names_missing_file_and_grid(tmp_path):
-    with pytest.raises(_native.InvalidInputError, match="nope.vdb"):
+    with pytest.raises(_native.IoError, match="nope.vdb"):
         _native.read_vdb(str(tmp_path / "nope.vdb"))
     path = str(tmp_path / "a.vdb")
     _native.write_vdb(path, {"density": np.ones((2, 2, 2), np.float32)}, [0, 0, 0], 1.0)
@@ -86,3 +86,12 @@ def test_gaussian_pyramid_halves_and_keeps_constants():
         np.testing.assert_allclose(lv, 0.25, atol=1e-6)
     with pytest.raises(_native.InvalidInputError, match="levels"):
         _native.gaussian_pyramid(vol, levels=0)
+
+
+def test_file_errors_are_oserrors(tmp_path):
+    """I/O failures are OSError (IoError), not bad input (InvalidInputError)."""
+    with pytest.raises(_native.IoError, match="not found") as missing:
+        _native.read_vdb(str(tmp_path / "nope.vdb"))
+    assert isinstance(missing.value, OSError) and isinstance(missing.value, _native.Error)
+    with pytest.raises(OSError, match="cannot write vdb file"):
+        _native.write_vdb(str(tmp_path), {"density": np.ones((2, 2, 2), np.float32)}, (0, 0, 0), 1.0)

@@ -137,3 +137,30 @@ def test_cancelled_context_stops_before_work(cube):
     ctx.cancel()
     with pytest.raises(_native.CancelledError):
         _native.voxelize(*cube, resolution=8, ctx=ctx)
+
+
+@pytest.mark.parametrize("vertices, faces, message", [
+    (np.array([[0, 0, 0], [np.nan, 0, 0], [0, 1, 0]], np.float32), [[0, 1, 2]], r"vertex 1 of --b is not finite \(nan\)"),
+    (np.eye(3), [[0, 1, 3]], "face 0 of --b refers to vertex 3 but the mesh has 3 vertices"),
+    (np.eye(3), np.zeros((0, 3), np.int32), "--b has no faces"),
+])
+def test_validate_mesh_names_the_problem(vertices, faces, message):
+    with pytest.raises(_native.InvalidInputError, match=message):
+        _native.validate_mesh(np.asarray(vertices, np.float64), np.asarray(faces, np.int32), "--b")
+    _native.validate_mesh(np.eye(3), np.array([[0, 1, 2]], np.int32))
+
+
+def test_a_millionth_sized_mesh_voxelizes_and_meshes(bunny, tmp_path):
+    """Voxels of ~1e-8 units: OpenVDB cannot hold such a transform, the engine
+    meshes in index space; writing a .vdb is refused with what to do."""
+    verts, faces = bunny
+    tiny = verts * 1e-6
+    grid = _native.voxelize(tiny, faces, resolution=24)
+    assert grid["voxel_size"] < 1e-6
+    v, f = _native.isosurface(grid["sdf"], grid["origin"], grid["voxel_size"])
+    assert len(f) > 100
+    extent = v.max(axis=0) - v.min(axis=0)
+    np.testing.assert_allclose(extent, tiny.max(axis=0) - tiny.min(axis=0), rtol=0.15)
+    with pytest.raises(_native.InvalidInputError, match="too small for an OpenVDB file.*scale the model up"):
+        _native.write_vdb(str(tmp_path / "tiny.vdb"), {"sdf": grid["sdf"]}, grid["origin"], grid["voxel_size"])
+    assert not (tmp_path / "tiny.vdb").exists()

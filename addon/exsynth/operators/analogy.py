@@ -263,10 +263,24 @@ class GeometricTextureJob(Job):
 
 
 # ---- reading the scene (main thread) ----------------------------------------------
-def check_settings(preset, resolution, pattern_scale):
-    """For a built-in pair: an InputError naming the setting to change, or None."""
+# The pair options the panel sets, by the names its fields show.
+PANEL_NAMES = {"feature_height": "Spike Height", "dilation": "Dilation"}
+
+
+def check_settings(preset, resolution, pattern_scale, options=None, names=PANEL_NAMES):
+    """For a built-in pair: an InputError naming the setting to change, or
+    None. `options` are the pair's shape options (pair_options()), checked by
+    the engine; `names` maps their engine names to the names the user set
+    them by (the panel's labels, the CLI's options)."""
     if preset not in PRESETS:
         raise InputError(f"unknown pair '{preset}'; choose one of {', '.join(PRESETS)}")
+    try:
+        _native.check_exemplar_pair(preset, **(options or {}))
+    except _native.InvalidInputError as exc:
+        message = str(exc)
+        for engine_name, user_name in names.items():
+            message = message.replace(engine_name, user_name)
+        raise InputError(message) from None
     r_pair = pair_resolution(resolution, pattern_scale)
     if r_pair < PAIR_MIN:
         raise InputError(
@@ -318,6 +332,10 @@ def source_triangles(obj, depsgraph, role, fix):
             f"{role} '{obj.name}' has no faces (only vertices or edges), so it has no inside; the "
             f"analogy works on solids. Give it faces (Edit Mode, select, F) or {fix[0].lower()}{fix[1:]}"
         )
+    try:  # as Voxelize checks it: a NaN vertex is named, not reported as "zero size"
+        _native.validate_mesh(verts, tris, f"{role} '{obj.name}'")
+    except _native.InvalidInputError as exc:
+        raise InputError(str(exc)) from None
     return verts, tris
 
 
@@ -468,7 +486,8 @@ class EXSYNTH_OT_geometric_texture(JobOperator, bpy.types.Operator):
             raise InputError("works in Object Mode only. Press Tab to leave Edit Mode and run it again")
         settings = context.scene.exsynth
         if settings.geo_pair_source == 'BUILTIN':
-            check_settings(settings.geo_preset.lower(), settings.geo_resolution, settings.geo_pattern_scale)
+            check_settings(settings.geo_preset.lower(), settings.geo_resolution, settings.geo_pattern_scale,
+                           pair_options(settings))
         obj = context.active_object
         if obj is None:
             raise InputError(

@@ -29,6 +29,15 @@ class Voxels:
     def dims_xyz(self):
         return tuple(reversed(self.density.shape))
 
+    def warning(self):
+        """What to tell the user when the mesh encloses nothing: an open or
+        flat mesh gives an all-empty density, which is valid but rarely meant."""
+        if float(self.density.max(initial=0.0)) >= 0.5:
+            return None
+        return (f"'{self.name}' encloses no volume (it is open, flat or too thin for the voxel size), so the "
+                "density is empty and the rebuilt mesh has no faces; close the mesh (e.g. a Solidify "
+                "modifier) or raise the resolution")
+
 
 @dataclasses.dataclass
 class VoxelizeJob(Job):
@@ -125,6 +134,8 @@ class EXSYNTH_OT_voxelize(JobOperator, bpy.types.Operator):
         summary = f"ExSynth: voxelized '{voxels.name}' into {nx}×{ny}×{nz} voxels of {voxels.voxel_size:.4g}"
         if voxels.surface is not None:
             summary += f", mesh of {len(voxels.surface[1])} triangles"
+        if voxels.warning():
+            self.report({'WARNING'}, f"ExSynth Voxelize: {voxels.warning()}")
         return summary
 
 

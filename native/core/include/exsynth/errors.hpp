@@ -24,6 +24,13 @@ class OverBudget : public Error {
   using Error::Error;
 };
 
+/// A file cannot be read or written (missing, unreadable, a folder, a full
+/// disk); maps to an OSError in Python.
+class IoError : public Error {
+ public:
+  using Error::Error;
+};
+
 /// The caller cancelled the job through its ExecContext.
 class Cancelled : public Error {
  public:

@@ -65,6 +65,10 @@ struct ExemplarPair {
 /// Cancelled via ctx.
 ExemplarPair make_exemplar_pair(PairPreset preset, const PairOptions& opt = {}, ExecContext* ctx = nullptr);
 
+/// Throws InvalidInput naming the first option out of range and the fix
+/// (what make_exemplar_pair checks first, without building anything).
+void validate_pair_options(PairPreset preset, const PairOptions& opt);
+
 /// "spikes", "pits", "holes", "grooves", "dilate".
 const char* pair_preset_name(PairPreset preset);
 

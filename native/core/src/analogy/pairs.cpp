@@ -1,5 +1,6 @@
 // Built-in exemplar pairs: analytic signed distances sampled on a grid.
 #include "exsynth/pairs.hpp"
+#include "exsynth/format.hpp"
 
 #include <algorithm>
 #include <array>
@@ -24,17 +25,15 @@ void require(bool ok, const std::string& message) {
   if (!ok) throw InvalidInput(message);
 }
 
-std::string num(double v) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%g", v);
-  return buf;
-}
+std::string num(double v) { return format_number(v); }
 
 void require_positive(double v, const char* name) {
   require(std::isfinite(v) && v > 0, std::string(name) + " must be a finite number > 0, got " + num(v));
 }
 
-void validate(PairPreset preset, const PairOptions& o) {
+}  // namespace
+
+void validate_pair_options(PairPreset preset, const PairOptions& o) {
   require(o.resolution >= 8 && o.resolution <= 512,
           "resolution must be in 8..512 (voxels per grid edge), got " + std::to_string(o.resolution));
   require_positive(o.thickness, "thickness");
@@ -81,6 +80,8 @@ void validate(PairPreset preset, const PairOptions& o) {
             "sphere_radius + dilation (" + num(o.sphere_radius + o.dilation) + ") must be at most " + num(kRoom) +
                 " so the dilated sphere fits the grid; lower sphere_radius or dilation");
 }
+
+namespace {
 
 // ---- primitives (exact signed distances) -------------------------------------
 
@@ -207,7 +208,7 @@ const char* pair_preset_name(PairPreset preset) {
 }
 
 ExemplarPair make_exemplar_pair(PairPreset preset, const PairOptions& opt, ExecContext* ctx) {
-  validate(preset, opt);
+  validate_pair_options(preset, opt);
   const int n = opt.resolution;
   const double voxels = double(n) * n * n;
   check_memory_budget(voxels * 5 * sizeof(float), opt.memory_budget,

@@ -34,7 +34,6 @@ void check_options(const Volume& vol, const IsosurfaceOptions& opt) {
   }
 }
 
-Eigen::Vector3f to_eigen(const openvdb::Vec3s& p) { return {p[0], p[1], p[2]}; }
 
 }  // namespace
 
@@ -81,11 +80,10 @@ TriangleMesh isosurface(const Volume& vol, const IsosurfaceOptions& opt, ExecCon
   // closed. This background puts the closing caps at most half a voxel
   // beyond the border voxels' centres (i.e. on the box's faces at most).
   const float background = std::max(vmax, iso) + (vmax - vmin);
+  // Meshed in index space (identity transform) and placed in world space
+  // below, in double: OpenVDB refuses voxel sizes below ~1.4e-5 units, and
+  // the values (not the transform) decide where the surface crosses.
   auto grid = openvdb::FloatGrid::create(background);
-  const GridTransform& xf = vol.transform();
-  auto transform = openvdb::math::Transform::createLinearTransform(xf.voxel_size);
-  transform->postTranslate(openvdb::Vec3d(xf.origin[0], xf.origin[1], xf.origin[2]));
-  grid->setTransform(transform);
   {
     openvdb::CoordBBox box(openvdb::Coord(0, 0, 0), openvdb::Coord(nx - 1, ny - 1, vol.nz() - 1));
     openvdb::tools::Dense<float, openvdb::tools::LayoutXYZ> dense(box, field.data());
@@ -106,7 +104,12 @@ TriangleMesh isosurface(const Volume& vol, const IsosurfaceOptions& opt, ExecCon
 
   TriangleMesh mesh;
   mesh.vertices.reserve(points.size());
-  for (const openvdb::Vec3s& p : points) mesh.vertices.push_back(to_eigen(p));
+  const GridTransform& xf = vol.transform();
+  for (const openvdb::Vec3s& p : points) {
+    Eigen::Vector3f w;
+    for (int k = 0; k < 3; ++k) w[k] = float(xf.origin[k] + xf.voxel_size * double(p[k]));
+    mesh.vertices.push_back(w);
+  }
   mesh.faces.reserve(tris.size() + 2 * quads.size());
   // OpenVDB's polygons are already counter-clockwise seen from the side
   // above the isovalue (checked by the tests with enclosed_volume).

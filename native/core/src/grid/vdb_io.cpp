@@ -1,4 +1,5 @@
 #include "exsynth/vdb_io.hpp"
+#include "exsynth/format.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -33,7 +34,15 @@ openvdb::CoordBBox index_box(const Volume& v) {
 openvdb::math::Transform::Ptr make_transform(const GridTransform& t) {
   // OpenVDB index coordinates are voxel centres, as ours are, so index 0
   // simply maps to the origin.
-  auto xf = openvdb::math::Transform::createLinearTransform(t.voxel_size);
+  openvdb::math::Transform::Ptr xf;
+  try {
+    xf = openvdb::math::Transform::createLinearTransform(t.voxel_size);
+  } catch (const openvdb::ArithmeticError&) {
+    // OpenVDB refuses scales whose cube is near zero (voxels below ~1.4e-5 units).
+    throw InvalidInput("the voxel size " + format_number(t.voxel_size) +
+                       " is too small for an OpenVDB file (about 1.5e-5 units at least); scale the model up "
+                       "(e.g. work in millimetres instead of metres) or use fewer voxels");
+  }
   xf->postTranslate(openvdb::Vec3d(t.origin[0], t.origin[1], t.origin[2]));
   return xf;
 }
@@ -165,7 +174,7 @@ void write_vdb(const std::string& path, const std::map<std::string, Volume>& gri
     file.write(out);
     file.close();
   } catch (const openvdb::Exception& e) {
-    throw InvalidInput("cannot write vdb file '" + path + "': " + e.what() +
+    throw IoError("cannot write vdb file '" + path + "': " + e.what() +
                        "; check that the folder exists and is writable");
   }
 }
@@ -173,7 +182,7 @@ void write_vdb(const std::string& path, const std::map<std::string, Volume>& gri
 std::map<std::string, Volume> read_vdb(const std::string& path,
                                        const std::vector<std::string>& names) {
   std::error_code ec;
-  if (!std::filesystem::exists(path, ec)) throw InvalidInput("vdb file '" + path + "' not found");
+  if (!std::filesystem::exists(path, ec)) throw IoError("vdb file '" + path + "' not found");
   ensure_openvdb();
 
   std::vector<openvdb::GridBase::Ptr> grids;
@@ -209,7 +218,7 @@ std::map<std::string, Volume> read_vdb(const std::string& path,
     }
     file.close();
   } catch (const openvdb::Exception& e) {
-    throw InvalidInput("cannot read vdb file '" + path + "': " + e.what());
+    throw IoError("cannot read vdb file '" + path + "': " + e.what());
   }
 
   const GridTransform xf0 = read_transform(*grids.front(), path);

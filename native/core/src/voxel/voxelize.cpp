@@ -1,4 +1,5 @@
 #include "exsynth/voxelize.hpp"
+#include "exsynth/format.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -20,7 +21,7 @@ constexpr int kMaxResolution = 1 << 14;
 void validate_options(const VoxelizeOptions& opt) {
   if (!std::isfinite(opt.voxel_size) || opt.voxel_size < 0)
     throw InvalidInput("voxel_size must be a finite number >= 0 (0 means: use resolution), got " +
-                       std::to_string(opt.voxel_size));
+                       format_number(opt.voxel_size));
   if (opt.voxel_size == 0 && (opt.resolution < 1 || opt.resolution > kMaxResolution))
     throw InvalidInput("resolution must be between 1 and " + std::to_string(kMaxResolution) +
                        " voxels along the longest axis, got " + std::to_string(opt.resolution));
@@ -60,7 +61,7 @@ VoxelGridSpec voxel_grid_spec(const TriangleMesh& mesh, const VoxelizeOptions& o
   for (int k = 0; k < 3; ++k) {
     const double cells = std::ceil(extent[k] / h - 1e-9);
     if (cells > kMaxResolution)
-      throw InvalidInput("voxel_size " + std::to_string(h) + " gives " + std::to_string(long(cells)) +
+      throw InvalidInput("voxel_size " + format_number(h) + " gives " + std::to_string(long(cells)) +
                          " voxels along an axis (max " + std::to_string(kMaxResolution) + "); use a larger voxel_size");
     *dims[k] = std::max(1, int(cells)) + 2 * opt.padding;
     // Centre the grid on the bounding box.

@@ -1,0 +1,136 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
+"""Bad or unusual input files and options for `./exsynth run`: the message
+names the option the user passed and the fix, nothing is written, and odd
+but valid inputs (a millionth-sized model, loose vertices) work."""
+
+import os
+
+import bpy
+import numpy as np
+import pytest
+
+from exsynth import cli
+from exsynth.operators import voxelize as voxelize_ops
+from helpers import BUNNY_OBJ, read_obj, scene_state
+
+B = ["analogy", "--b", BUNNY_OBJ, "--resolution", "24"]
+
+
+def run(capsys, *args):
+    code = cli.main(list(args))
+    return code, capsys.readouterr().err
+
+
+def scaled_bunny(path, scale):
+    lines = []
+    for line in open(BUNNY_OBJ).read().splitlines():
+        if line.startswith("v "):
+            line = "v " + " ".join(f"{float(t) * scale:.9e}" for t in line.split()[1:4])
+        lines.append(line)
+    path.write_text("\n".join(lines) + "\n")
+    return str(path)
+
+
+@pytest.mark.parametrize("args, message", [
+    (["--preset", "dilate", "--dilation", "-5"], "--dilation must be a finite number > 0, got -5"),
+    (["--preset", "spikes", "--spike-height", "5"], "--spike-height (5) plus half the thickness"),
+])
+def test_pair_options_are_named_as_the_user_gave_them(tmp_path, capsys, args, message):
+    code, err = run(capsys, *B, *args, "--out", str(tmp_path / "x.obj"))
+    assert code == 2 and message in err
+    assert "padding" not in err and "feature_height" not in err
+    assert os.listdir(tmp_path) == []
+
+
+def test_a_nan_vertex_is_named(tmp_path, capsys):
+    text = open(BUNNY_OBJ).read().replace("v 1.301895 0.122622 2.550061", "v nan 0.122622 2.550061", 1)
+    assert "v nan" in text
+    (tmp_path / "nan.obj").write_text(text)
+    code, err = run(capsys, "analogy", "--b", str(tmp_path / "nan.obj"), "--preset", "spikes", "--resolution", "24",
+                    "--out", str(tmp_path / "x.obj"))
+    assert code == 2
+    assert "vertex 0 of --b nan.obj is not finite (nan)" in err
+    assert os.listdir(tmp_path) == ["nan.obj"]
+
+
+def test_a_millionth_sized_model_works(tmp_path, capsys):
+    """Voxels of ~1e-8 units (OpenVDB cannot hold such a transform)."""
+    tiny = scaled_bunny(tmp_path / "tiny.obj", 1e-6)
+    out = tmp_path / "x.obj"
+    code, err = run(capsys, "analogy", "--b", tiny, "--preset", "spikes", "--resolution", "24", "--out", str(out))
+    assert code == 0, err
+    verts, faces = read_obj(out)
+    assert len(faces) > 100
+    assert 1e-7 < np.ptp(verts, axis=0).max() < 1e-5
+    # A .vdb cannot store such voxels: refused with what to do, nothing written.
+    code, err = run(capsys, "voxelize", "--mesh", tiny, "--resolution", "16", "--out", str(tmp_path / "t.vdb"))
+    assert code == 1 and "too small for an OpenVDB file" in err and "scale the model up" in err
+    assert sorted(os.listdir(tmp_path)) == ["tiny.obj", "x.obj"]
+
+
+def test_a_folder_given_as_an_input_file(tmp_path, capsys):
+    code, err = run(capsys, "voxelize", "--mesh", str(tmp_path), "--out", str(tmp_path / "x.npy"))
+    assert code == 2 and f"--mesh: {tmp_path} is a folder; give a file in it" in err
+
+
+def test_out_of_range_face_indices_are_reported(tmp_path, capsys):
+    """Blender's importer would drop the face and carry on with a hole."""
+    path = tmp_path / "broken.obj"
+    path.write_text(open(BUNNY_OBJ).read() + "f 1 2 99999\n")
+    code, err = run(capsys, "voxelize", "--mesh", str(path), "--out", str(tmp_path / "x.npy"))
+    assert code == 2
+    assert "face vertex 99999 is out of range (the file has 1839 vertices" in err
+    assert os.listdir(tmp_path) == ["broken.obj"]
+
+
+def test_field_keeps_every_vertex_of_the_file(tmp_path, capsys):
+    """One row per vertex of the file, in its order, loose vertices included;
+    --paint with one row per file vertex is accepted."""
+    path = tmp_path / "loose.obj"
+    path.write_text(open(BUNNY_OBJ).read() + "v 9 9 9\n")
+    out = tmp_path / "f.npy"
+    code, err = run(capsys, "field", "--mesh", str(path), "--preset", "around_axis", "--out", str(out))
+    assert code == 0, err
+    field = np.load(out)
+    assert field.shape == (1840, 3)
+    np.testing.assert_allclose(np.linalg.norm(field, axis=1), 1.0, atol=1e-5)
+    paint = np.zeros((1840, 3))
+    paint[0] = (1, 0, 0)
+    np.save(tmp_path / "paint.npy", paint)
+    code, err = run(capsys, "field", "--mesh", str(path), "--paint", str(tmp_path / "paint.npy"), "--out", str(out))
+    assert code == 0, err
+    assert np.load(out).shape == (1840, 3)
+
+
+def test_field_paint_with_nan_names_the_option(tmp_path, capsys):
+    paint = np.zeros((1839, 3))
+    paint[7] = np.nan
+    np.save(tmp_path / "paint.npy", paint)
+    code, err = run(capsys, "field", "--mesh", BUNNY_OBJ, "--paint", str(tmp_path / "paint.npy"),
+                    "--out", str(tmp_path / "f.npy"))
+    assert code == 2
+    assert "--paint: row 7 of" in err and "'given'" not in err
+
+
+def test_an_open_mesh_is_voxelized_with_a_warning(tmp_path, capsys):
+    path = tmp_path / "plane.obj"
+    path.write_text("v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\nf 1 2 4 3\n")
+    code, err = run(capsys, "voxelize", "--mesh", str(path), "--resolution", "16", "--out", str(tmp_path / "x.npy"))
+    assert code == 0
+    assert "warning: 'plane' encloses no volume" in err
+
+
+def test_the_voxelize_operator_warns_about_an_empty_result():
+    voxels = voxelize_ops.Voxels("Plane", np.zeros((2, 2, 2), np.float32), np.ones((2, 2, 2), np.float32),
+                                 np.zeros(3), 1.0)
+    assert "encloses no volume" in voxels.warning()
+    voxels.density[0, 0, 0] = 1.0
+    assert voxels.warning() is None
+
+
+def test_geometric_texture_names_a_nan_vertex(bunny):
+    bunny.data.vertices[3].co = (float("nan"), 0.0, 0.0)
+    before = scene_state()
+    with pytest.raises(RuntimeError, match=r"vertex 3 of the active object 'bunny' is not finite"):
+        bpy.ops.exsynth.geometric_texture()
+    assert scene_state() == before

@@ -1,0 +1,132 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
+"""`./exsynth run` writes all its files or none: unwritable paths are refused
+before the job starts, a failed, cancelled or interrupted job leaves no new
+file and an existing one untouched, and a bad number never reaches the
+engine (no traceback)."""
+
+import os
+import signal
+import subprocess
+
+import numpy as np
+import pytest
+
+from exsynth import cli
+from helpers import BUNNY_OBJ, ROOT, TEXTURES
+
+CRACKED = os.path.join(TEXTURES, "crackedground.png")
+FAST_SOLID = ["--size", "8", "--levels", "1", "--iterations", "1"]
+
+
+def run(capsys, *args):
+    code = cli.main(list(args))
+    return code, capsys.readouterr().err
+
+
+def test_out_is_a_folder(tmp_path, capsys):
+    code, err = run(capsys, "analogy", "--b", BUNNY_OBJ, "--preset", "spikes", "--resolution", "24",
+                    "--out", str(tmp_path))
+    assert code == 2
+    assert f"--out: {tmp_path} is a folder; give a file name" in err
+    assert os.listdir(tmp_path) == []
+
+
+@pytest.mark.parametrize("job", [
+    ["voxelize", "--mesh", BUNNY_OBJ, "--resolution", "16"],
+    ["analogy", "--b", BUNNY_OBJ, "--preset", "spikes", "--resolution", "24"],
+])
+def test_mesh_out_that_cannot_be_written(tmp_path, capsys, job):
+    out = tmp_path / "x.npy"
+    mesh_out = "/proc/exsynth_cannot_write.obj"
+    args = [*job, "--out", mesh_out] if job[0] == "analogy" else [*job, "--out", str(out), "--mesh-out", mesh_out]
+    code, err = run(capsys, *args)
+    assert code == 2
+    assert f"cannot write {mesh_out}" in err
+    assert os.listdir(tmp_path) == []
+
+
+def test_no_partial_output_when_a_later_file_fails(tmp_path, capsys):
+    """The issue's case: the bake cannot be written, so the solid is not left either."""
+    out = tmp_path / "S.npy"
+    code, err = run(capsys, "solid", "--exemplar", CRACKED, *FAST_SOLID, "--mesh", BUNNY_OBJ,
+                    "--bake-out", "/proc/exsynth_bake.png", "--out", str(out))
+    assert code == 2 and "--bake-out: cannot write" in err
+    assert os.listdir(tmp_path) == []
+
+
+def test_a_failed_job_leaves_the_existing_file_untouched(tmp_path, capsys):
+    out = tmp_path / "x.vdb"
+    out.write_bytes(b"an earlier result")
+    code, err = run(capsys, "voxelize", "--mesh", BUNNY_OBJ, "--resolution", "400", "--memory-budget", "0.001",
+                    "--out", str(out))
+    assert code == 1 and "over the memory budget" in err and "nothing was written" in err
+    assert out.read_bytes() == b"an earlier result"
+    assert os.listdir(tmp_path) == ["x.vdb"]
+
+
+def test_an_exporter_that_writes_nothing_fails_the_job(tmp_path, capsys, monkeypatch):
+    """Blender's OBJ exporter returns FINISHED without a file on some paths:
+    the job must fail, not print '-> path' and exit 0."""
+    monkeypatch.setattr(cli, "export_obj", lambda *args: None)
+    out, mesh_out = tmp_path / "x.npy", tmp_path / "m.obj"
+    code, err = run(capsys, "voxelize", "--mesh", BUNNY_OBJ, "--resolution", "16", "--out", str(out),
+                    "--mesh-out", str(mesh_out))
+    assert code == 1
+    assert f"--mesh-out: nothing was written to {mesh_out}" in err
+    assert os.listdir(tmp_path) == []
+
+
+def test_successful_outputs_replace_old_files(tmp_path, capsys):
+    out = tmp_path / "x.npy"
+    out.write_bytes(b"old")
+    code, _ = run(capsys, "voxelize", "--mesh", BUNNY_OBJ, "--resolution", "16", "--out", str(out))
+    assert code == 0
+    assert np.load(out).ndim == 4
+    assert os.listdir(tmp_path) == ["x.npy"]
+
+
+@pytest.mark.parametrize("option, message", [
+    (["--seed", "-1"], "argument --seed: -1 is out of range; give 0 .. 2**64-1"),
+    (["--seed", str(2**64)], "is out of range; give 0 .. 2**64-1"),
+    (["--seed", "1.5"], "argument --seed: '1.5' is not a whole number"),
+    (["--memory-budget", "inf"], "argument --memory-budget: inf GiB is out of range"),
+    (["--memory-budget", "1e30"], "argument --memory-budget: 1e30 GiB is out of range"),
+    (["--memory-budget", "-1"], "argument --memory-budget: -1 GiB is out of range"),
+    (["--resolution", str(2**31)], "argument --resolution: 2147483648 is far too large"),
+    (["--voxel-size", "nan"], "argument --voxel-size: nan is not a finite number"),
+])
+def test_numbers_out_of_range_are_refused_by_name(tmp_path, capsys, option, message):
+    code, err = run(capsys, "voxelize", "--mesh", BUNNY_OBJ, "--out", str(tmp_path / "x.npy"), *option)
+    assert code == 2
+    assert message in err
+    assert "Traceback" not in err
+    assert os.listdir(tmp_path) == []
+
+
+def test_seed_up_to_2_64_minus_1_works(tmp_path, capsys):
+    code, _ = run(capsys, "voxelize", "--mesh", BUNNY_OBJ, "--resolution", "12", "--seed", str(2**64 - 1),
+                  "--out", str(tmp_path / "x.npy"))
+    assert code == 0
+
+
+def test_ctrl_c_cancels_the_job_and_writes_nothing(tmp_path):
+    """SIGINT to `./exsynth run` (Blender itself only notes it and carries on)."""
+    out = tmp_path / "solid.npy"
+    proc = subprocess.Popen(
+        [os.path.join(ROOT, "exsynth"), "run", "solid", "--exemplar", CRACKED, "--size", "64", "--out", str(out)],
+        stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    try:
+        lines = []
+        for line in proc.stderr:  # the CLI names each stage as the job reaches it
+            lines.append(line)
+            if line.startswith("exsynth solid: "):
+                break
+        proc.send_signal(signal.SIGINT)
+        _, rest = proc.communicate(timeout=120)
+    finally:
+        proc.kill()
+    err = "".join(lines) + rest
+    assert proc.returncode == cli.EXIT_INTERRUPTED, err
+    assert "interrupted (Ctrl-C); nothing was written" in err
+    assert "Traceback" not in err
+    assert os.listdir(tmp_path) == []
