@@ -134,3 +134,30 @@ def test_geometric_texture_names_a_nan_vertex(bunny):
     with pytest.raises(RuntimeError, match=r"vertex 3 of the active object 'bunny' is not finite"):
         bpy.ops.exsynth.geometric_texture()
     assert scene_state() == before
+
+
+def moved_bunny(path, dx):
+    lines = []
+    for line in open(BUNNY_OBJ).read().splitlines():
+        if line.startswith("v "):
+            x, y, z = (float(t) for t in line.split()[1:4])
+            line = f"v {x + dx:.6f} {y:.6f} {z:.6f}"
+        lines.append(line)
+    path.write_text("\n".join(lines) + "\n")
+    return str(path)
+
+
+def test_a_prime_away_from_a_is_the_cause_named(tmp_path, capsys):
+    far = moved_bunny(tmp_path / "far.obj", 300.0)
+    code, err = run(capsys, *B, "--a", BUNNY_OBJ, "--a-prime", far, "--out", str(tmp_path / "x.obj"))
+    assert code == 2
+    assert "A′ lies away from A (their bounding boxes do not overlap)" in err and "voxel_size" not in err
+    assert os.listdir(tmp_path) == ["far.obj"]
+
+
+def test_analogy_budget_message_names_what_the_cli_can_change(tmp_path, capsys):
+    code, err = run(capsys, *B, "--preset", "spikes", "--memory-budget", "0.001", "--out", str(tmp_path / "x.obj"))
+    assert code == 1
+    assert "over the memory budget" in err and "lower the resolution or raise the memory budget" in err
+    assert "voxel_size" not in err
+    assert os.listdir(tmp_path) == []

@@ -46,6 +46,8 @@ def write_vdb(path, grids, origin, voxel_size, created):
         created.add_file(folder)
     created.add_file(path)  # recorded first: a half-written file goes too
     _native.write_vdb(path, grids, origin, voxel_size)
+    if not os.path.isfile(path) or os.path.getsize(path) == 0:
+        raise OSError(f"the volume file {path} was not written (is the disk full?); nothing was changed")
 
 
 def new_volume_object(name, path, voxel_size, collection, created):

@@ -63,6 +63,16 @@ def voxel_size_for(vertices, resolution):
     return longest / resolution
 
 
+def _voxelize(role, vertices, triangles, **options):
+    """_native.voxelize at B's voxel size; over budget, the message says what
+    the user can change (the resolution; the voxel size is derived from it)."""
+    try:
+        return _native.voxelize(vertices, triangles, **options)
+    except _native.OverBudgetError as exc:
+        need = str(exc).split(";")[0]
+        raise _native.OverBudgetError(f"{role}: {need}; lower the resolution or raise the memory budget") from None
+
+
 # ---- plain data handed to the worker -------------------------------------------
 @dataclasses.dataclass
 class FieldSpec:
@@ -179,7 +189,7 @@ class GeometricTextureJob(Job):
             padding = self.padding()
             region = None
         self.share(ctx, 0.15, 0.22)
-        grid = _native.voxelize(self.b.vertices, self.b.triangles, voxel_size=h, padding=padding, **common)
+        grid = _voxelize("B", self.b.vertices, self.b.triangles, voxel_size=h, padding=padding, **common)
         b, origin = grid["sdf"], grid["origin"]
         field_b = self.b.field.frames_t(self.b, grid, ctx, span=(0.22, 0.27))
         if not self.user_pair:
@@ -235,8 +245,8 @@ class GeometricTextureJob(Job):
         for k, mesh in enumerate((self.a, self.a_prime)):
             self.share(ctx, 0.04 * k, 0.04 * (k + 1))
             verts = np.concatenate([np.asarray(mesh.vertices, np.float64), corners])
-            grids.append(_native.voxelize(verts, mesh.triangles, voxel_size=h,
-                                          padding=NEIGHBOURHOOD_PADDING + 1, **common))
+            grids.append(_voxelize("A′" if k else "A", verts, mesh.triangles, voxel_size=h,
+                                   padding=NEIGHBOURHOOD_PADDING + 1, **common))
         a, a_prime = grids[0]["sdf"], grids[1]["sdf"]
         if float(np.abs(a - a_prime).max()) < 0.1 * h:
             raise ValueError(
@@ -254,8 +264,8 @@ class GeometricTextureJob(Job):
             # reach as far as its growth from them.
             verts, tris = self.a.region
             self.share(ctx, 0.12, 0.15)
-            near = _native.voxelize(np.concatenate([np.asarray(verts, np.float64), corners]), tris,
-                                    voxel_size=h, padding=NEIGHBOURHOOD_PADDING + 1, **common)["sdf"]
+            near = _voxelize("the selected faces of A", np.concatenate([np.asarray(verts, np.float64), corners]),
+                             tris, voxel_size=h, padding=NEIGHBOURHOOD_PADDING + 1, **common)["sdf"]
             if near.shape != a.shape:
                 raise RuntimeError(f"the selected faces' grid {near.shape} is not A's {a.shape}")
             region = (np.abs(near) <= growth + NEIGHBOURHOOD_PADDING * h).astype(np.float32)
@@ -297,6 +307,13 @@ def check_settings(preset, resolution, pattern_scale, options=None, names=PANEL_
 
 def check_user_pair_grid(b_vertices, a_vertices, a_prime_vertices, resolution):
     """A user pair is voxelized with B's voxel: refuse one that is huge next to B."""
+    lo_a, hi_a = a_vertices.min(0), a_vertices.max(0)
+    lo_p, hi_p = a_prime_vertices.min(0), a_prime_vertices.max(0)
+    if np.any(lo_p > hi_a) or np.any(lo_a > hi_p):
+        raise InputError(
+            "A′ lies away from A (their bounding boxes do not overlap), so the grid holding both would be "
+            "mostly empty; A′ must be A with the change modelled on it, in the same place. Move A′ onto A"
+        )
     h = voxel_size_for(b_vertices, resolution)
     both = np.concatenate([a_vertices, a_prime_vertices])
     sides = np.ceil((both.max(0) - both.min(0)) / h).astype(np.int64) + 2 * (NEIGHBOURHOOD_PADDING + 1)

@@ -76,7 +76,8 @@ VoxelizeResult voxelize(const TriangleMesh& input, const VoxelizeOptions& opt, E
   check_memory_budget(estimate_bytes(g, input), opt.memory_budget,
                       "voxelizing at " + std::to_string(g.nx) + "x" + std::to_string(g.ny) + "x" +
                           std::to_string(g.nz) + " voxels",
-                      "lower the resolution (or raise voxel_size) or raise the memory budget");
+                      opt.voxel_size > 0 ? "raise voxel_size or the memory budget"
+                                         : "lower the resolution or raise the memory budget");
   const int n[3] = {g.nx, g.ny, g.nz};
   const std::size_t voxels = std::size_t(g.nx) * g.ny * g.nz;
   const std::size_t stride[3] = {1, std::size_t(g.nx), std::size_t(g.nx) * g.ny};
