@@ -190,4 +190,9 @@ py::dict dict_arg(const py::handle& v, const std::string& name, const std::strin
   return py::reinterpret_borrow<py::dict>(v);
 }
 
+void reject_unknown(const py::kwargs& extra, const std::string& options) {
+  for (const auto item : extra)
+    throw InvalidInput("unknown option '" + py::str(item.first).cast<std::string>() + "'; options: " + options);
+}
+
 }  // namespace exsynth::py_bind

@@ -25,6 +25,27 @@ namespace exsynth::py_bind {
 
 namespace py = pybind11;
 
+/// Parameter types of the bound functions: each takes any Python object (the
+/// *_arg functions below check it) and only names the expected type in the
+/// function's signature and docstring.
+#define EXSYNTH_ANY_ARG(Type)                                       \
+  struct Type : py::object {                                        \
+    using py::object::object;                                       \
+    static bool check_(py::handle h) { return h.ptr() != nullptr; } \
+  }
+EXSYNTH_ANY_ARG(IntArg);
+EXSYNTH_ANY_ARG(RealArg);
+EXSYNTH_ANY_ARG(BoolArg);
+EXSYNTH_ANY_ARG(StrArg);
+EXSYNTH_ANY_ARG(ArrayArg);
+EXSYNTH_ANY_ARG(OptionalArrayArg);
+EXSYNTH_ANY_ARG(Vec3Arg);
+EXSYNTH_ANY_ARG(ContextArg);
+EXSYNTH_ANY_ARG(PathArg);
+EXSYNTH_ANY_ARG(GridsArg);
+EXSYNTH_ANY_ARG(NamesArg);
+#undef EXSYNTH_ANY_ARG
+
 /// An integer (Python int or NumPy integer; not a float) in [lo, hi].
 long long integer_arg(const py::handle& v, const std::string& name, long long lo, long long hi,
                       const std::string& unit = "");
@@ -70,7 +91,30 @@ ExecContext* context_arg(const py::handle& v, const std::string& name = "ctx");
 /// A dict (for keyword collections such as write_vdb's grids).
 py::dict dict_arg(const py::handle& v, const std::string& name, const std::string& expected);
 
+/// Functions with fixed options also take **extra, so a misspelt keyword
+/// is an InvalidInputError naming it and the options instead of pybind11's
+/// signature dump (which prints every array passed).
+void reject_unknown(const py::kwargs& extra, const std::string& options);
+
 /// repr(v), shortened to a line, for messages.
 std::string short_repr(const py::handle& v);
 
 }  // namespace exsynth::py_bind
+
+namespace pybind11::detail {
+#define EXSYNTH_ARG_NAME(Type, text) \
+  template <>                        \
+  struct handle_type_name<exsynth::py_bind::Type> { static constexpr auto name = const_name(text); }
+EXSYNTH_ARG_NAME(IntArg, "int");
+EXSYNTH_ARG_NAME(RealArg, "float");
+EXSYNTH_ARG_NAME(BoolArg, "bool");
+EXSYNTH_ARG_NAME(StrArg, "str");
+EXSYNTH_ARG_NAME(ArrayArg, "numpy.ndarray");
+EXSYNTH_ARG_NAME(OptionalArrayArg, "numpy.ndarray | None");
+EXSYNTH_ARG_NAME(Vec3Arg, "tuple[float, float, float]");
+EXSYNTH_ARG_NAME(ContextArg, "ExecContext | None");
+EXSYNTH_ARG_NAME(PathArg, "str | os.PathLike");
+EXSYNTH_ARG_NAME(GridsArg, "dict[str, numpy.ndarray]");
+EXSYNTH_ARG_NAME(NamesArg, "list[str] | None");
+#undef EXSYNTH_ARG_NAME
+}  // namespace pybind11::detail

@@ -13,13 +13,16 @@ namespace exsynth::py_bind {
 void bind_analogy(py::module_& m) {
   m.def(
       "synthesize_analogy",
-      [](const py::object& a_arg, const py::object& a_prime_arg, const py::object& b_arg, const py::object& field_a,
-         const py::object& field_b, const py::object& voxel_size, const py::object& levels,
-         const py::object& fine_size, const py::object& coarse_size, const py::object& sweeps,
-         const py::object& pca_variance, const py::object& max_pca_dims, const py::object& ann_eps,
-         const py::object& coherence, const py::object& coherence_slack, const py::object& cull_distance,
-         const py::object& remove_debris, const py::object& a_region, const py::object& memory_budget,
-         const py::object& seed, const py::object& ctx_arg) {
+      [](const ArrayArg& a_arg, const ArrayArg& a_prime_arg, const ArrayArg& b_arg, const OptionalArrayArg& field_a,
+         const OptionalArrayArg& field_b, const RealArg& voxel_size, const IntArg& levels,
+         const IntArg& fine_size, const IntArg& coarse_size, const IntArg& sweeps,
+         const RealArg& pca_variance, const IntArg& max_pca_dims, const RealArg& ann_eps,
+         const RealArg& coherence, const RealArg& coherence_slack, const RealArg& cull_distance,
+         const BoolArg& remove_debris, const OptionalArrayArg& a_region, const IntArg& memory_budget,
+         const IntArg& seed, const ContextArg& ctx_arg, const py::kwargs& extra) {
+        reject_unknown(extra, "field_a, field_b, voxel_size, levels, fine_size, coarse_size, sweeps, pca_variance, "
+                              "max_pca_dims, ann_eps, coherence, coherence_slack, cull_distance, remove_debris, a_region, "
+                              "memory_budget, seed, ctx");
         const char* expected = "a (Z, Y, X) float32 volume";
         const py::array a = array_arg(a_arg, "a", expected), a_prime = array_arg(a_prime_arg, "a_prime", expected),
                         b = array_arg(b_arg, "b", expected);

@@ -42,8 +42,9 @@ std::vector<std::array<Eigen::Matrix<float, K, 1>, 3>> to_corners(const py::hand
 void bind_bake(py::module_& m) {
   m.def(
       "sample_volume",
-      [](const py::object& volume, const py::object& origin, const py::object& voxel_size, const py::object& points,
-         const py::object& wrap_arg, const py::object& ctx_arg) {
+      [](const ArrayArg& volume, const Vec3Arg& origin, const RealArg& voxel_size, const ArrayArg& points,
+         const BoolArg& wrap_arg, const ContextArg& ctx_arg, const py::kwargs& extra) {
+        reject_unknown(extra, "wrap, ctx");
         const Volume v = to_volume(volume, "volume", to_transform(origin, voxel_size));
         const std::vector<Eigen::Vector3f> p = to_points(points, "points");
         const bool wrap = bool_arg(wrap_arg, "wrap");
@@ -62,9 +63,10 @@ void bind_bake(py::module_& m) {
 
   m.def(
       "bake_volume_to_uv",
-      [](const py::object& volume, const py::object& origin, const py::object& voxel_size, const py::object& positions,
-         const py::object& uvs, const py::object& width_arg, const py::object& height_arg, const py::object& wrap,
-         const py::object& margin, const py::object& ctx_arg) {
+      [](const ArrayArg& volume, const Vec3Arg& origin, const RealArg& voxel_size, const ArrayArg& positions,
+         const ArrayArg& uvs, const IntArg& width_arg, const IntArg& height_arg, const BoolArg& wrap,
+         const IntArg& margin, const ContextArg& ctx_arg, const py::kwargs& extra) {
+        reject_unknown(extra, "wrap, margin, ctx");
         const int width = int_arg(width_arg, "width", 1, kMaxBakeSize, "texels");
         const int height = int_arg(height_arg, "height", 1, kMaxBakeSize, "texels");
         const Volume v = to_volume(volume, "volume", to_transform(origin, voxel_size));

@@ -61,7 +61,7 @@ void bind_core(py::module_& m) {
       .def_property_readonly("stage", &ExecContext::stage)
       .def(
           "set_span",
-          [](ExecContext& c, const py::object& lo, const py::object& hi) {
+          [](ExecContext& c, const RealArg& lo, const RealArg& hi) {
             const double l = real_arg(lo, "lo", 0.0, 1.0), h = real_arg(hi, "hi", 0.0, 1.0);
             if (l > h)
               throw InvalidInput("'lo' must not exceed 'hi' (the share [lo, hi] of the progress bar), got lo=" +

@@ -86,7 +86,7 @@ FieldPreset to_preset(const std::string& s) {
 void bind_field(py::module_& m) {
   m.def(
       "diffuse_direction_field",
-      [](const py::object& vertices, const py::object& faces, const py::object& given, const py::object& ctx_arg,
+      [](const ArrayArg& vertices, const ArrayArg& faces, const ArrayArg& given, const ContextArg& ctx_arg,
          const py::kwargs& kw) {
         ExecContext* ctx = context_arg(ctx_arg);
         const TriangleMesh mesh = to_mesh(vertices, faces);
@@ -114,8 +114,9 @@ painted vertices keep their projected direction. Releases the GIL; reports to ct
 
   m.def(
       "preset_direction_field",
-      [](const py::object& vertices, const py::object& faces, const py::object& preset, const py::object& axis,
-         const py::object& curve, const py::object& ctx_arg) {
+      [](const ArrayArg& vertices, const ArrayArg& faces, const StrArg& preset, const Vec3Arg& axis,
+         const OptionalArrayArg& curve, const ContextArg& ctx_arg, const py::kwargs& extra) {
+        reject_unknown(extra, "preset, axis, curve, ctx");
         const TriangleMesh mesh = to_mesh(vertices, faces);
         const FieldPreset p = to_preset(string_arg(preset, "preset", "'around_axis', 'along_axis' or 'along_curve'"));
         ExecContext* ctx = context_arg(ctx_arg);

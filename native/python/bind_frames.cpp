@@ -13,9 +13,10 @@ namespace exsynth::py_bind {
 void bind_frames(py::module_& m) {
   m.def(
       "volume_frames",
-      [](const py::object& sdf_arg, const py::object& origin, const py::object& voxel_size,
-         const py::object& points_arg, const py::object& vectors_arg, const py::object& band,
-         const py::object& smoothing_steps, const py::object& ctx_arg) {
+      [](const ArrayArg& sdf_arg, const Vec3Arg& origin, const RealArg& voxel_size,
+         const ArrayArg& points_arg, const ArrayArg& vectors_arg, const RealArg& band,
+         const IntArg& smoothing_steps, const ContextArg& ctx_arg, const py::kwargs& extra) {
+        reject_unknown(extra, "band, smoothing_steps, ctx");
         const py::array sdf = array_arg(sdf_arg, "sdf", "a (Z, Y, X) float32 signed distance volume");
         check_shape(sdf, "sdf", {-1, -1, -1}, "a (Z, Y, X) float32 signed distance volume");
         const Volume v = to_volume(sdf, "sdf", to_transform(origin, voxel_size));

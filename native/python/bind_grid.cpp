@@ -16,8 +16,9 @@ namespace exsynth::py_bind {
 void bind_grid(py::module_& m) {
   m.def(
       "write_vdb",
-      [](const py::object& path_arg_, const py::object& grids_arg, const py::object& origin,
-         const py::object& voxel_size) {
+      [](const PathArg& path_arg_, const GridsArg& grids_arg, const Vec3Arg& origin,
+         const RealArg& voxel_size, const py::kwargs& extra) {
+        reject_unknown(extra, "path, grids, origin, voxel_size");
         const std::string path = path_arg(path_arg_, "path");
         const py::dict grids = dict_arg(grids_arg, "grids", "a dict of grid name -> (Z, Y, X) or (Z, Y, X, C) float32 array");
         const GridTransform t = to_transform(origin, voxel_size);
@@ -38,7 +39,8 @@ void bind_grid(py::module_& m) {
 
   m.def(
       "read_vdb",
-      [](const py::object& path_arg_, const py::object& names_arg) {
+      [](const PathArg& path_arg_, const NamesArg& names_arg, const py::kwargs& extra) {
+        reject_unknown(extra, "path, names");
         const std::string path = path_arg(path_arg_, "path");
         const std::vector<std::string> names = names_arg.is_none() ? std::vector<std::string>{}
                                                                    : string_list_arg(names_arg, "names");
@@ -65,8 +67,10 @@ void bind_grid(py::module_& m) {
 
   m.def(
       "isosurface",
-      [](const py::object& volume_arg, const py::object& origin, const py::object& voxel_size,
-         const py::object& isovalue, const py::object& adaptivity, const py::object& invert, const py::object& ctx_arg) {
+      [](const ArrayArg& volume_arg, const Vec3Arg& origin, const RealArg& voxel_size,
+         const RealArg& isovalue, const RealArg& adaptivity, const BoolArg& invert, const ContextArg& ctx_arg,
+         const py::kwargs& extra) {
+        reject_unknown(extra, "isovalue, adaptivity, invert, ctx");
         const py::array volume = array_arg(volume_arg, "volume", "a (Z, Y, X) float32 array");
         check_shape(volume, "volume", {-1, -1, -1}, "a (Z, Y, X) float32 array");
         const Volume v = to_volume(volume, "volume", to_transform(origin, voxel_size));
@@ -97,7 +101,9 @@ void bind_grid(py::module_& m) {
 
   m.def(
       "gaussian_pyramid",
-      [](const py::object& volume, const py::object& levels, const py::object& wrap, const py::object& ctx_arg) {
+      [](const ArrayArg& volume, const IntArg& levels, const BoolArg& wrap, const ContextArg& ctx_arg,
+         const py::kwargs& extra) {
+        reject_unknown(extra, "levels, wrap, ctx");
         const Volume v = to_volume(volume, "volume", GridTransform{});
         PyramidOptions opt;
         opt.levels = int_arg(levels, "levels", 1, kMaxPyramidLevels);

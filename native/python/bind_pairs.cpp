@@ -58,7 +58,7 @@ void apply_options(PairOptions& o, const py::kwargs& kw) {
 void bind_pairs(py::module_& m) {
   m.def(
       "make_exemplar_pair",
-      [](const py::object& preset, const py::object& resolution, const py::object& seed, const py::object& ctx_arg,
+      [](const StrArg& preset, const IntArg& resolution, const IntArg& seed, const ContextArg& ctx_arg,
          const py::kwargs& kw) {
         PairOptions opt;
         opt.resolution = int_arg(resolution, "resolution", kMinPairResolution, kMaxPairResolution, "voxels per grid edge");

@@ -101,8 +101,8 @@ py::list to_list(const std::vector<double>& v) {
 void bind_solid(py::module_& m) {
   m.def(
       "synthesize_solid",
-      [](const py::object& exemplar, const py::object& exemplar_y, const py::object& exemplar_z,
-         const py::object& views_arg, const py::object& size, const py::object& constraint, const py::object& ctx_arg,
+      [](const ArrayArg& exemplar, const OptionalArrayArg& exemplar_y, const OptionalArrayArg& exemplar_z,
+         const StrArg& views_arg, const IntArg& size, const OptionalArrayArg& constraint, const ContextArg& ctx_arg,
          const py::kwargs& kw) {
         const std::string views = string_arg(views_arg, "views", "the active slices, e.g. 'xyz' or 'xy'");
         ExecContext* ctx = context_arg(ctx_arg);
@@ -151,7 +151,7 @@ Returns {'solid': (Z, Y, X, C) float32, 'energy': [...], 'energy_level': [...]}.
 
   m.def(
       "synthesize_image",
-      [](const py::object& exemplar, const py::object& width, const py::object& height, const py::object& ctx_arg,
+      [](const ArrayArg& exemplar, const IntArg& width, const IntArg& height, const ContextArg& ctx_arg,
          const py::kwargs& kw) {
         ExecContext* ctx = context_arg(ctx_arg);
         const Image ex = to_image(exemplar, "exemplar");

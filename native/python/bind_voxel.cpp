@@ -12,10 +12,11 @@ namespace exsynth::py_bind {
 void bind_voxel(py::module_& m) {
   m.def(
       "voxelize",
-      [](const py::object& vertices, const py::object& faces, const py::object& resolution,
-         const py::object& voxel_size, const py::object& padding, const py::object& supersample,
-         const py::object& compute_sdf, const py::object& memory_budget, const py::object& seed,
-         const py::object& ctx_arg) {
+      [](const ArrayArg& vertices, const ArrayArg& faces, const IntArg& resolution,
+         const RealArg& voxel_size, const IntArg& padding, const IntArg& supersample,
+         const BoolArg& compute_sdf, const IntArg& memory_budget, const IntArg& seed,
+         const ContextArg& ctx_arg, const py::kwargs& extra) {
+        reject_unknown(extra, "resolution, voxel_size, padding, supersample, compute_sdf, memory_budget, seed, ctx");
         TriangleMesh mesh = to_mesh(vertices, faces);
         VoxelizeOptions opt;
         opt.resolution = int_arg(resolution, "resolution", 1, kMaxVoxelResolution, "voxels along the longest axis");

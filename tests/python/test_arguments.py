@@ -126,6 +126,15 @@ def test_bad_argument_is_an_invalid_input_error_naming_it(fn, arg, value, words)
     assert len(msg) < 400, msg  # no dump of the arrays passed
 
 
+@pytest.mark.parametrize("fn", sorted(FUNCTIONS))
+def test_a_misspelt_keyword_is_named_with_the_options(fn):
+    run, args = FUNCTIONS[fn]
+    with pytest.raises(_native.InvalidInputError) as info:
+        run(resolutoin=3)
+    msg = str(info.value)
+    assert "unknown option 'resolutoin'" in msg and "options" in msg and len(msg) < 400, msg
+
+
 def test_invalid_input_error_is_a_value_error():
     assert issubclass(_native.InvalidInputError, ValueError)
 
@@ -253,6 +262,8 @@ def test_vdb_arguments_are_checked(tmp_path):
         (lambda: _native.read_vdb(None), ["'path'"]),
         (lambda: _native.read_vdb(str(path), 5), ["'names'", "list"]),
         (lambda: _native.read_vdb(str(path), ["density", 3]), ["'names'", "item 1"]),
+        (lambda: _native.read_vdb(str(path), grid="density"), ["unknown option 'grid'", "names"]),
+        (lambda: _native.write_vdb(str(path), {"d": VOL}, [0, 0, 0], 1.0, mode="w"), ["unknown option 'mode'"]),
     ]
     for run, words in cases:
         with pytest.raises(_native.InvalidInputError) as info:
