@@ -3,6 +3,7 @@
 #include <cmath>
 #include <sstream>
 
+#include "arguments.hpp"
 #include "exsynth/errors.hpp"
 
 namespace exsynth::py_bind {
@@ -53,7 +54,9 @@ void copy_faces(const py::array& a, TriangleMesh& m) {
 
 }  // namespace
 
-TriangleMesh to_mesh(const py::array& vertices, const py::array& faces) {
+TriangleMesh to_mesh(const py::handle& vertices_arg, const py::handle& faces_arg) {
+  const py::array vertices = array_arg(vertices_arg, "vertices", "a V by 3 float32 or float64 array");
+  const py::array faces = array_arg(faces_arg, "faces", "an F by 3 int32 or int64 array of vertex indices");
   check_shape(vertices, "vertices", {-1, 3}, "a V by 3 float32 or float64 array");
   check_shape(faces, "faces", {-1, 3}, "an F by 3 int32 or int64 array of vertex indices");
   TriangleMesh m;
@@ -75,7 +78,8 @@ TriangleMesh to_mesh(const py::array& vertices, const py::array& faces) {
   return m;
 }
 
-Volume to_volume(const py::array& a, const char* name, const GridTransform& xform) {
+Volume to_volume(const py::handle& arg, const char* name, const GridTransform& xform) {
+  const py::array a = array_arg(arg, name, "a (Z, Y, X) or (Z, Y, X, C) float32 array");
   if (a.ndim() != 3 && a.ndim() != 4)
     throw InvalidInput(std::string("'") + name + "' must be a (Z, Y, X) or (Z, Y, X, C) float32 array, got a " +
                        describe(a));
@@ -110,6 +114,10 @@ GridTransform to_transform(const py::handle& origin, double voxel_size) {
     throw InvalidInput("'voxel_size' must be a finite number > 0, got " + std::to_string(voxel_size));
   t.voxel_size = voxel_size;
   return t;
+}
+
+GridTransform to_transform(const py::handle& origin, const py::handle& voxel_size) {
+  return to_transform(origin, real_arg(voxel_size, "voxel_size", 0.0, kInf, Ends::OpenLow));
 }
 
 py::array from_volume(Volume&& v) {

@@ -23,13 +23,17 @@ void check_shape(const py::array& a, const char* name, std::initializer_list<py:
 
 /// V by 3 float32/float64 vertices and F by 3 int32/int64 faces -> mesh.
 /// Finiteness and index range are checked by the core (validate_mesh).
-TriangleMesh to_mesh(const py::array& vertices, const py::array& faces);
+/// Lists and tuples are converted by NumPy (see array_arg).
+TriangleMesh to_mesh(const py::handle& vertices, const py::handle& faces);
 
 /// A (Z, Y, X) or (Z, Y, X, C) float32/float64 array -> Volume (copied).
-Volume to_volume(const py::array& a, const char* name, const GridTransform& xform);
+/// Lists and tuples are converted by NumPy (see array_arg).
+Volume to_volume(const py::handle& a, const char* name, const GridTransform& xform);
 
 /// Origin (3 floats) and voxel size -> transform; checks finiteness, size > 0.
 GridTransform to_transform(const py::handle& origin, double voxel_size);
+/// The same with voxel_size a Python number (checked: finite, > 0).
+GridTransform to_transform(const py::handle& origin, const py::handle& voxel_size);
 
 /// Volume -> (Z, Y, X) array when it has one channel, else (Z, Y, X, C);
 /// the buffer is moved, not copied.

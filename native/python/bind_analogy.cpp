@@ -1,6 +1,7 @@
 // exsynth._native.synthesize_analogy
 #include <pybind11/pybind11.h>
 
+#include "arguments.hpp"
 #include "arrays.hpp"
 #include "exsynth/analogy.hpp"
 #include "exsynth/errors.hpp"
@@ -12,45 +13,56 @@ namespace exsynth::py_bind {
 void bind_analogy(py::module_& m) {
   m.def(
       "synthesize_analogy",
-      [](const py::array& a, const py::array& a_prime, const py::array& b, const py::object& field_a,
-         const py::object& field_b, double voxel_size, int levels, int fine_size, int coarse_size, int sweeps,
-         double pca_variance, int max_pca_dims, double ann_eps, double coherence, double coherence_slack, double cull_distance, bool remove_debris, const py::object& a_region,
-         std::size_t memory_budget, std::uint64_t seed, ExecContext* ctx) {
+      [](const ArrayArg& a_arg, const ArrayArg& a_prime_arg, const ArrayArg& b_arg, const OptionalArrayArg& field_a,
+         const OptionalArrayArg& field_b, const RealArg& voxel_size, const IntArg& levels,
+         const IntArg& fine_size, const IntArg& coarse_size, const IntArg& sweeps,
+         const RealArg& pca_variance, const IntArg& max_pca_dims, const RealArg& ann_eps,
+         const RealArg& coherence, const RealArg& coherence_slack, const RealArg& cull_distance,
+         const BoolArg& remove_debris, const OptionalArrayArg& a_region, const IntArg& memory_budget,
+         const IntArg& seed, const ContextArg& ctx_arg, const py::kwargs& extra) {
+        reject_unknown(extra, "field_a, field_b, voxel_size, levels, fine_size, coarse_size, sweeps, pca_variance, "
+                              "max_pca_dims, ann_eps, coherence, coherence_slack, cull_distance, remove_debris, a_region, "
+                              "memory_budget, seed, ctx");
+        const char* expected = "a (Z, Y, X) float32 volume";
+        const py::array a = array_arg(a_arg, "a", expected), a_prime = array_arg(a_prime_arg, "a_prime", expected),
+                        b = array_arg(b_arg, "b", expected);
         for (const auto& [arr, name] : {std::pair<const py::array&, const char*>{a, "a"}, {a_prime, "a_prime"}, {b, "b"}})
-          check_shape(arr, name, {-1, -1, -1}, "a (Z, Y, X) float32 volume");
+          check_shape(arr, name, {-1, -1, -1}, expected);
         if (field_a.is_none() != field_b.is_none())
           throw InvalidInput("give both field_a and field_b (a field-aligned analogy) or neither (isotropic)");
         const GridTransform t = to_transform(py::make_tuple(0.0, 0.0, 0.0), voxel_size);
         const Volume va = to_volume(a, "a", t), vap = to_volume(a_prime, "a_prime", t), vb = to_volume(b, "b", t);
         Volume fa, fb;
         if (!field_a.is_none()) {
-          const py::array arr_a = py::array::ensure(field_a), arr_b = py::array::ensure(field_b);
-          if (!arr_a || !arr_b) throw InvalidInput("field_a and field_b must be arrays of shape (Z, Y, X, 3)");
+          const py::array arr_a = array_arg(field_a, "field_a", "a (Z, Y, X, 3) float32 direction per voxel of A");
+          const py::array arr_b = array_arg(field_b, "field_b", "a (Z, Y, X, 3) float32 direction per voxel of B");
           check_shape(arr_a, "field_a", {-1, -1, -1, 3}, "a (Z, Y, X, 3) float32 direction per voxel of A");
           check_shape(arr_b, "field_b", {-1, -1, -1, 3}, "a (Z, Y, X, 3) float32 direction per voxel of B");
           fa = to_volume(arr_a, "field_a", t);
           fb = to_volume(arr_b, "field_b", t);
         }
+        using Lim = AnalogyLimits;
         AnalogyOptions opt;
-        opt.levels = levels;
-        opt.fine_size = fine_size;
-        opt.coarse_size = coarse_size;
-        opt.sweeps = sweeps;
-        opt.pca_variance = pca_variance;
-        opt.max_pca_dims = max_pca_dims;
-        opt.ann_eps = ann_eps;
-        opt.coherence = coherence;
-        opt.coherence_slack = coherence_slack;
-        opt.cull_distance = cull_distance;
-        opt.remove_debris = remove_debris;
+        opt.levels = int_arg(levels, "levels", 1, Lim::max_levels);
+        opt.fine_size = int_arg(fine_size, "fine_size", Lim::min_fine_size, Lim::max_fine_size, "odd");
+        opt.coarse_size = int_arg(coarse_size, "coarse_size", Lim::min_coarse_size, Lim::max_coarse_size, "odd");
+        opt.sweeps = int_arg(sweeps, "sweeps", 1, Lim::max_sweeps);
+        opt.pca_variance = real_arg(pca_variance, "pca_variance", 0.0, 1.0, Ends::OpenLow);
+        opt.max_pca_dims = int_arg(max_pca_dims, "max_pca_dims", 1, Lim::max_pca_dims);
+        opt.ann_eps = real_arg(ann_eps, "ann_eps", 0.0, kInf);
+        opt.coherence = real_arg(coherence, "coherence", 0.0, kInf);
+        opt.coherence_slack = real_arg(coherence_slack, "coherence_slack", 0.0, kInf);
+        opt.cull_distance = real_arg(cull_distance, "cull_distance", -kInf, kInf, Ends::Closed,
+                                     "world units; < 0 = automatic, 0 = off");
+        opt.remove_debris = bool_arg(remove_debris, "remove_debris");
         if (!a_region.is_none()) {
-          const py::array arr = py::array::ensure(a_region);
-          if (!arr) throw InvalidInput("a_region must be a (Z, Y, X) array on A's grid");
+          const py::array arr = array_arg(a_region, "a_region", "a (Z, Y, X) float32 mask on A's grid");
           check_shape(arr, "a_region", {-1, -1, -1}, "a (Z, Y, X) float32 mask on A's grid (> 0.5 = learn here)");
           opt.a_region = to_volume(arr, "a_region", t);
         }
-        opt.memory_budget = memory_budget ? memory_budget : kDefaultMemoryBudget;
-        opt.seed = seed;
+        opt.memory_budget = memory_budget_arg(memory_budget);
+        opt.seed = seed_arg(seed);
+        ExecContext* ctx = context_arg(ctx_arg);
         AnalogyResult r;
         {
           py::gil_scoped_release release;
@@ -70,8 +82,7 @@ void bind_analogy(py::module_& m) {
       py::arg("pca_variance") = 0.95, py::arg("max_pca_dims") = 24, py::arg("ann_eps") = 0.5, py::arg("coherence") = 1.0,
       py::arg("coherence_slack") = 0.05,
       py::arg("cull_distance") = -1.0, py::arg("remove_debris") = true,
-      py::arg("a_region") = py::none(), py::arg("memory_budget") = std::size_t(0), py::arg("seed") = std::uint64_t(0),
-      py::arg("ctx") = static_cast<ExecContext*>(nullptr),
+      py::arg("a_region") = py::none(), py::arg("memory_budget") = 0, py::arg("seed") = 0, py::arg("ctx") = py::none(),
       R"doc(Volume analogy B' : B :: A' : A (Bhat et al. 2004). a, a_prime: (Z, Y, X) float32 on one
 grid; b: (Z, Y, X) float32 on a grid of the same voxel_size (world units; used for automatic
 culling of signed distances: cull_distance < 0 = the fine half-width, 0 = off).

@@ -1,6 +1,7 @@
 // exsynth._native.sample_volume / bake_volume_to_uv
 #include <pybind11/pybind11.h>
 
+#include "arguments.hpp"
 #include "arrays.hpp"
 #include "exsynth/bake.hpp"
 #include "exsynth/errors.hpp"
@@ -11,7 +12,8 @@ namespace exsynth::py_bind {
 namespace {
 
 /// (N, 3) float -> points; (F, 3, K) float -> per-corner vectors.
-std::vector<Eigen::Vector3f> to_points(const py::array& a, const char* name) {
+std::vector<Eigen::Vector3f> to_points(const py::handle& arg, const char* name) {
+  const py::array a = array_arg(arg, name, "an N by 3 float32 or float64 array");
   check_shape(a, name, {-1, 3}, "an N by 3 float32 or float64 array");
   auto f = py::array_t<float, py::array::c_style | py::array::forcecast>::ensure(a);
   if (!f) throw InvalidInput(std::string("'") + name + "' must be a float array, got a " + describe(a));
@@ -21,8 +23,9 @@ std::vector<Eigen::Vector3f> to_points(const py::array& a, const char* name) {
 }
 
 template <int K>
-std::vector<std::array<Eigen::Matrix<float, K, 1>, 3>> to_corners(const py::array& a, const char* name,
+std::vector<std::array<Eigen::Matrix<float, K, 1>, 3>> to_corners(const py::handle& arg, const char* name,
                                                                   const char* expected) {
+  const py::array a = array_arg(arg, name, expected);
   check_shape(a, name, {-1, 3, K}, expected);
   auto f = py::array_t<float, py::array::c_style | py::array::forcecast>::ensure(a);
   if (!f) throw InvalidInput(std::string("'") + name + "' must be a float array, got a " + describe(a));
@@ -39,10 +42,13 @@ std::vector<std::array<Eigen::Matrix<float, K, 1>, 3>> to_corners(const py::arra
 void bind_bake(py::module_& m) {
   m.def(
       "sample_volume",
-      [](const py::array& volume, const py::handle& origin, double voxel_size, const py::array& points, bool wrap,
-         ExecContext* ctx) {
+      [](const ArrayArg& volume, const Vec3Arg& origin, const RealArg& voxel_size, const ArrayArg& points,
+         const BoolArg& wrap_arg, const ContextArg& ctx_arg, const py::kwargs& extra) {
+        reject_unknown(extra, "wrap, ctx");
         const Volume v = to_volume(volume, "volume", to_transform(origin, voxel_size));
         const std::vector<Eigen::Vector3f> p = to_points(points, "points");
+        const bool wrap = bool_arg(wrap_arg, "wrap");
+        ExecContext* ctx = context_arg(ctx_arg);
         std::vector<float> out(p.size() * v.channels());
         {
           py::gil_scoped_release release;
@@ -51,22 +57,27 @@ void bind_bake(py::module_& m) {
         return take_vector(std::move(out), {py::ssize_t(p.size()), py::ssize_t(v.channels())});
       },
       py::arg("volume"), py::arg("origin"), py::arg("voxel_size"), py::arg("points"), py::kw_only(),
-      py::arg("wrap") = true, py::arg("ctx") = static_cast<ExecContext*>(nullptr),
+      py::arg("wrap") = true, py::arg("ctx") = py::none(),
       "Trilinear samples of a (Z,Y,X) or (Z,Y,X,C) volume at N by 3 points (the volume's space)\n"
       "-> (N, C) float32. wrap=True repeats the volume (a tiling solid).");
 
   m.def(
       "bake_volume_to_uv",
-      [](const py::array& volume, const py::handle& origin, double voxel_size, const py::array& positions,
-         const py::array& uvs, int width, int height, bool wrap, int margin, ExecContext* ctx) {
+      [](const ArrayArg& volume, const Vec3Arg& origin, const RealArg& voxel_size, const ArrayArg& positions,
+         const ArrayArg& uvs, const IntArg& width_arg, const IntArg& height_arg, const BoolArg& wrap,
+         const IntArg& margin, const ContextArg& ctx_arg, const py::kwargs& extra) {
+        reject_unknown(extra, "wrap, margin, ctx");
+        const int width = int_arg(width_arg, "width", 1, kMaxBakeSize, "texels");
+        const int height = int_arg(height_arg, "height", 1, kMaxBakeSize, "texels");
         const Volume v = to_volume(volume, "volume", to_transform(origin, voxel_size));
         const auto pos = to_corners<3>(positions, "positions", "an (F, 3, 3) float array: each triangle's corner positions");
         const auto uv = to_corners<2>(uvs, "uvs", "an (F, 3, 2) float array: each triangle's corner UVs");
         BakeOptions opt;
         opt.width = width;
         opt.height = height;
-        opt.wrap = wrap;
-        opt.margin = margin;
+        opt.wrap = bool_arg(wrap, "wrap");
+        opt.margin = int_arg(margin, "margin", 0, kMaxBakeMargin, "texels");
+        ExecContext* ctx = context_arg(ctx_arg);
         BakeResult r;
         {
           py::gil_scoped_release release;
@@ -77,7 +88,7 @@ void bind_bake(py::module_& m) {
       },
       py::arg("volume"), py::arg("origin"), py::arg("voxel_size"), py::arg("positions"), py::arg("uvs"),
       py::arg("width"), py::arg("height"), py::kw_only(), py::arg("wrap") = true, py::arg("margin") = 4,
-      py::arg("ctx") = static_cast<ExecContext*>(nullptr),
+      py::arg("ctx") = py::none(),
       "Bake a volume into a UV-mapped image: positions (F,3,3) corner positions in the volume's space,\n"
       "uvs (F,3,2) corner UVs. Returns (image (H,W,C) float32 with row 0 at v = 0, mask (H,W) uint8:\n"
       "1 covered, 2 margin, 0 empty).");

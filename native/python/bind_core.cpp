@@ -4,6 +4,7 @@
 #include "exsynth/errors.hpp"
 #include "exsynth/exec_context.hpp"
 #include "exsynth/memory_budget.hpp"
+#include "arguments.hpp"
 
 namespace py = pybind11;
 
@@ -63,7 +64,16 @@ void bind_core(py::module_& m) {
       .def_property_readonly("cancelled", &ExecContext::cancelled)
       .def_property_readonly("progress", &ExecContext::progress)
       .def_property_readonly("stage", &ExecContext::stage)
-      .def("set_span", &ExecContext::set_span, py::arg("lo"), py::arg("hi"),
+      .def(
+          "set_span",
+          [](ExecContext& c, const RealArg& lo, const RealArg& hi) {
+            const double l = real_arg(lo, "lo", 0.0, 1.0), h = real_arg(hi, "hi", 0.0, 1.0);
+            if (l > h)
+              throw InvalidInput("'lo' must not exceed 'hi' (the share [lo, hi] of the progress bar), got lo=" +
+                                 short_repr(lo) + ", hi=" + short_repr(hi));
+            c.set_span(l, h);
+          },
+          py::arg("lo"), py::arg("hi"),
            "Give the next call the share [lo, hi] of the progress bar: its own 0..1 then reads lo..hi.")
       .def("__repr__", [](const ExecContext& c) {
         return "<ExecContext stage='" + c.stage() + "' progress=" + std::to_string(c.progress()) +

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <string>
 
+#include "arguments.hpp"
 #include "arrays.hpp"
 #include "exsynth/errors.hpp"
 #include "exsynth/field.hpp"
@@ -14,9 +15,14 @@ namespace exsynth::py_bind {
 namespace {
 
 /// (rows, 3) float32/float64 -> vectors, finite; rows = -1: any.
-std::vector<Eigen::Vector3f> to_vectors(const py::array& a, const char* name, py::ssize_t rows, const std::string& expected) {
+std::vector<Eigen::Vector3f> to_vectors(const py::handle& arg, const char* name, py::ssize_t rows, const std::string& expected) {
+  const py::array a = array_arg(arg, name, expected);
   check_shape(a, name, {rows, 3}, expected.c_str());
-  if (!a.dtype().is(py::dtype::of<float>()) && !a.dtype().is(py::dtype::of<double>()))
+  // A list of numbers may hold ints (a curve typed in by hand); an integer
+  // array is refused (it is usually indices passed by mistake).
+  const char kind = a.dtype().kind();
+  const bool listed = !py::isinstance<py::array>(arg);
+  if (kind != 'f' && !(listed && (kind == 'i' || kind == 'u')))
     throw InvalidInput(std::string("'") + name + "' must have dtype float32 or float64, got " + describe(a));
   auto d = py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(a);
   auto r = d.unchecked<2>();
@@ -53,14 +59,14 @@ DirectionFieldOptions to_options(const py::kwargs& kw) {
   for (auto item : kw) {
     const std::string k = py::str(item.first);
     if (k == "weights") {
-      const std::string w = item.second.cast<std::string>();
+      const std::string w = string_arg(item.second, "weights", "'cotangent' or 'uniform'");
       if (w == "cotangent") o.weights = FieldWeights::Cotangent;
       else if (w == "uniform") o.weights = FieldWeights::Uniform;
       else throw InvalidInput("weights must be 'cotangent' or 'uniform', got '" + w + "'");
     } else if (k == "fallback_axis") {
       o.fallback_axis = to_vec3(item.second, "fallback_axis");
     } else if (k == "seed") {
-      o.seed = item.second.cast<std::uint64_t>();
+      o.seed = seed_arg(item.second);
     } else {
       throw InvalidInput("unknown option '" + k + "'; options: weights, fallback_axis, seed");
     }
@@ -80,8 +86,9 @@ FieldPreset to_preset(const std::string& s) {
 void bind_field(py::module_& m) {
   m.def(
       "diffuse_direction_field",
-      [](const py::array& vertices, const py::array& faces, const py::array& given, ExecContext* ctx,
+      [](const ArrayArg& vertices, const ArrayArg& faces, const ArrayArg& given, const ContextArg& ctx_arg,
          const py::kwargs& kw) {
+        ExecContext* ctx = context_arg(ctx_arg);
         const TriangleMesh mesh = to_mesh(vertices, faces);
         const py::ssize_t v = py::ssize_t(mesh.vertices.size());
         const std::vector<Eigen::Vector3f> g = to_vectors(
@@ -95,7 +102,7 @@ void bind_field(py::module_& m) {
         return from_vectors(field);
       },
       py::arg("vertices"), py::arg("faces"), py::arg("given"), py::kw_only(),
-      py::arg("ctx") = static_cast<ExecContext*>(nullptr),
+      py::arg("ctx") = py::none(),
       R"doc(Interpolate painted vectors into a unit tangent field over the surface (as Turk 2001).
 
 vertices: V by 3 float32/float64; faces: F by 3 int32/int64. given: V by 3 float32/float64, one
@@ -107,17 +114,17 @@ painted vertices keep their projected direction. Releases the GIL; reports to ct
 
   m.def(
       "preset_direction_field",
-      [](const py::array& vertices, const py::array& faces, const std::string& preset, const py::object& axis,
-         const py::object& curve, ExecContext* ctx) {
+      [](const ArrayArg& vertices, const ArrayArg& faces, const StrArg& preset, const Vec3Arg& axis,
+         const OptionalArrayArg& curve, const ContextArg& ctx_arg, const py::kwargs& extra) {
+        reject_unknown(extra, "preset, axis, curve, ctx");
         const TriangleMesh mesh = to_mesh(vertices, faces);
-        const FieldPreset p = to_preset(preset);
+        const FieldPreset p = to_preset(string_arg(preset, "preset", "'around_axis', 'along_axis' or 'along_curve'"));
+        ExecContext* ctx = context_arg(ctx_arg);
         const Eigen::Vector3f a = to_vec3(axis, "axis");
         std::vector<Eigen::Vector3f> points;
         if (!curve.is_none()) {
           // Any numeric sequence: a Blender curve's points often arrive as a list.
-          const py::array c = py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(curve);
-          if (!c) throw InvalidInput("'curve' must be an N by 3 array of points");
-          points = to_vectors(c, "curve", -1, "an N by 3 float32 or float64 array of points (N >= 2)");
+          points = to_vectors(curve, "curve", -1, "an N by 3 float32 or float64 array of points (N >= 2)");
         } else if (p == FieldPreset::AlongCurve) {
           throw InvalidInput("'curve' is required for preset='along_curve': an N by 3 array of points (N >= 2)");
         }
@@ -130,7 +137,7 @@ painted vertices keep their projected direction. Releases the GIL; reports to ct
       },
       py::arg("vertices"), py::arg("faces"), py::arg("preset") = "around_axis", py::kw_only(),
       py::arg("axis") = py::make_tuple(0.0, 0.0, 1.0), py::arg("curve") = py::none(),
-      py::arg("ctx") = static_cast<ExecContext*>(nullptr),
+      py::arg("ctx") = py::none(),
       R"doc(A unit tangent field from a preset, for meshes without a painted field.
 
 preset: 'around_axis' (circles around `axis` through the surface centroid), 'along_axis'

@@ -2,6 +2,7 @@
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 
+#include "arguments.hpp"
 #include "arrays.hpp"
 #include "exsynth/errors.hpp"
 #include "exsynth/isosurface.hpp"
@@ -15,16 +16,19 @@ namespace exsynth::py_bind {
 void bind_grid(py::module_& m) {
   m.def(
       "write_vdb",
-      [](const std::string& path, const py::dict& grids, const py::handle& origin, double voxel_size) {
+      [](const PathArg& path_arg_, const GridsArg& grids_arg, const Vec3Arg& origin,
+         const RealArg& voxel_size, const py::kwargs& extra) {
+        reject_unknown(extra, "path, grids, origin, voxel_size");
+        const std::string path = path_arg(path_arg_, "path");
+        const py::dict grids = dict_arg(grids_arg, "grids", "a dict of grid name -> (Z, Y, X) or (Z, Y, X, C) float32 array");
         const GridTransform t = to_transform(origin, voxel_size);
         if (grids.empty()) throw InvalidInput("'grids' is empty; pass at least one name -> array");
         std::map<std::string, Volume> volumes;
         for (auto item : grids) {
           const std::string name = py::str(item.first);
-          if (!py::isinstance<py::array>(item.second))
-            throw InvalidInput("grid '" + name + "' must be a NumPy float32 array, got " +
-                               std::string(py::str(item.second.get_type())));
-          volumes.emplace(name, to_volume(py::reinterpret_borrow<py::array>(item.second), name.c_str(), t));
+          if (!PyUnicode_Check(item.first.ptr()))
+            throw InvalidInput("the keys of 'grids' must be grid names (str), got " + short_repr(item.first));
+          volumes.emplace(name, to_volume(item.second, name.c_str(), t));
         }
         py::gil_scoped_release release;
         write_vdb(path, volumes);
@@ -35,7 +39,11 @@ void bind_grid(py::module_& m) {
 
   m.def(
       "read_vdb",
-      [](const std::string& path, const std::vector<std::string>& names) {
+      [](const PathArg& path_arg_, const NamesArg& names_arg, const py::kwargs& extra) {
+        reject_unknown(extra, "path, names");
+        const std::string path = path_arg(path_arg_, "path");
+        const std::vector<std::string> names = names_arg.is_none() ? std::vector<std::string>{}
+                                                                   : string_list_arg(names_arg, "names");
         std::map<std::string, Volume> volumes;
         {
           py::gil_scoped_release release;
@@ -53,22 +61,24 @@ void bind_grid(py::module_& m) {
         out["voxel_size"] = t.voxel_size;
         return out;
       },
-      py::arg("path"), py::arg("names") = std::vector<std::string>{},
+      py::arg("path"), py::arg("names") = py::none(),
       "Read float/vec3 grids (all, or `names`) from a .vdb into dense arrays over the union\n"
       "of their active voxels. Returns {'grids': {name: array}, 'origin', 'voxel_size'}.");
 
   m.def(
       "isosurface",
-      [](const py::array& volume, const py::handle& origin, double voxel_size, double isovalue, double adaptivity,
-         bool invert, ExecContext* ctx) {
+      [](const ArrayArg& volume_arg, const Vec3Arg& origin, const RealArg& voxel_size,
+         const RealArg& isovalue, const RealArg& adaptivity, const BoolArg& invert, const ContextArg& ctx_arg,
+         const py::kwargs& extra) {
+        reject_unknown(extra, "isovalue, adaptivity, invert, ctx");
+        const py::array volume = array_arg(volume_arg, "volume", "a (Z, Y, X) float32 array");
         check_shape(volume, "volume", {-1, -1, -1}, "a (Z, Y, X) float32 array");
         const Volume v = to_volume(volume, "volume", to_transform(origin, voxel_size));
-        if (!(adaptivity >= 0 && adaptivity <= 1))
-          throw InvalidInput("'adaptivity' must be in [0, 1], got " + std::to_string(adaptivity));
         IsosurfaceOptions opt;
-        opt.isovalue = isovalue;
-        opt.adaptivity = adaptivity;
-        opt.invert = invert;
+        opt.isovalue = real_arg(isovalue, "isovalue");
+        opt.adaptivity = real_arg(adaptivity, "adaptivity", 0.0, 1.0);
+        opt.invert = bool_arg(invert, "invert");
+        ExecContext* ctx = context_arg(ctx_arg);
         TriangleMesh mesh;
         {
           py::gil_scoped_release release;
@@ -84,18 +94,21 @@ void bind_grid(py::module_& m) {
         return py::make_tuple(take_vector(std::move(verts), {nv, 3}), take_vector(std::move(tris), {nf, 3}));
       },
       py::arg("volume"), py::arg("origin"), py::arg("voxel_size"), py::kw_only(), py::arg("isovalue") = 0.0,
-      py::arg("adaptivity") = 0.0, py::arg("invert") = false, py::arg("ctx") = static_cast<ExecContext*>(nullptr),
+      py::arg("adaptivity") = 0.0, py::arg("invert") = false, py::arg("ctx") = py::none(),
       "OpenVDB volume -> mesh. Returns (verts (V,3) float32 world positions, tris (F,3) int32),\n"
       "counter-clockwise seen from outside; outside = values above isovalue (an SDF), or below\n"
       "with invert=True (a density).");
 
   m.def(
       "gaussian_pyramid",
-      [](const py::array& volume, int levels, bool wrap, ExecContext* ctx) {
+      [](const ArrayArg& volume, const IntArg& levels, const BoolArg& wrap, const ContextArg& ctx_arg,
+         const py::kwargs& extra) {
+        reject_unknown(extra, "levels, wrap, ctx");
         const Volume v = to_volume(volume, "volume", GridTransform{});
         PyramidOptions opt;
-        opt.levels = levels;
-        opt.boundary = wrap ? Boundary::Wrap : Boundary::Clamp;
+        opt.levels = int_arg(levels, "levels", 1, kMaxPyramidLevels);
+        opt.boundary = bool_arg(wrap, "wrap") ? Boundary::Wrap : Boundary::Clamp;
+        ExecContext* ctx = context_arg(ctx_arg);
         std::vector<Volume> pyr;
         {
           py::gil_scoped_release release;
@@ -106,7 +119,7 @@ void bind_grid(py::module_& m) {
         return out;
       },
       py::arg("volume"), py::kw_only(), py::arg("levels") = 3, py::arg("wrap") = false,
-      py::arg("ctx") = static_cast<ExecContext*>(nullptr),
+      py::arg("ctx") = py::none(),
       "Gaussian pyramid of a (Z,Y,X) or (Z,Y,X,C) volume: list of levels, finest first.");
 }
 

@@ -3,6 +3,7 @@
 
 #include <string>
 
+#include "arguments.hpp"
 #include "arrays.hpp"
 #include "exsynth/errors.hpp"
 #include "exsynth/pairs.hpp"
@@ -25,36 +26,27 @@ PairPreset to_preset(const std::string& s) {
   throw InvalidInput("preset must be 'spikes', 'pits', 'holes', 'grooves' or 'dilate', got '" + s + "'");
 }
 
-template <class T>
-T option(const py::handle& v, const std::string& name, const char* expected) {
-  try {
-    return v.cast<T>();
-  } catch (const py::cast_error&) {
-    throw InvalidInput("option '" + name + "' must be " + expected + ", got " +
-                       std::string(py::str(py::type::of(v).attr("__name__"))));
-  }
-}
-
 void apply_options(PairOptions& o, const py::kwargs& kw) {
   for (auto item : kw) {
     const std::string k = py::str(item.first);
     const py::handle v = item.second;
-    if (k == "thickness") o.thickness = option<double>(v, k, "a number");
-    else if (k == "spacing") o.spacing = option<double>(v, k, "a number");
-    else if (k == "feature_radius") o.feature_radius = option<double>(v, k, "a number");
-    else if (k == "feature_height") o.feature_height = option<double>(v, k, "a number");
-    else if (k == "jitter") o.jitter = option<double>(v, k, "a number");
-    else if (k == "cylinder_radius") o.cylinder_radius = option<double>(v, k, "a number");
-    else if (k == "sphere_radius") o.sphere_radius = option<double>(v, k, "a number");
-    else if (k == "dilation") o.dilation = option<double>(v, k, "a number");
+    // Lengths are world units on the [-1, 1] grid; the core checks how they fit together.
+    auto length = [&](double& field) { field = real_arg(v, k, 0.0, kInf, Ends::OpenLow, "world units"); };
+    if (k == "thickness") length(o.thickness);
+    else if (k == "spacing") length(o.spacing);
+    else if (k == "feature_radius") length(o.feature_radius);
+    else if (k == "feature_height") length(o.feature_height);
+    else if (k == "jitter") o.jitter = real_arg(v, k, 0.0, 0.25, Ends::Closed, "a fraction of spacing");
+    else if (k == "cylinder_radius") length(o.cylinder_radius);
+    else if (k == "sphere_radius") length(o.sphere_radius);
+    else if (k == "dilation") length(o.dilation);
     else if (k == "groove_direction") {
-      const std::string d = option<std::string>(v, k, "'around' or 'along'");
+      const std::string d = string_arg(v, k, "'around' or 'along'");
       if (d == "around") o.groove_direction = GrooveDirection::Around;
       else if (d == "along") o.groove_direction = GrooveDirection::Along;
       else throw InvalidInput("groove_direction must be 'around' or 'along', got '" + d + "'");
     } else if (k == "memory_budget") {
-      const std::size_t b = option<std::size_t>(v, k, "a non-negative integer (bytes; 0 = default)");
-      o.memory_budget = b ? b : kDefaultMemoryBudget;
+      o.memory_budget = memory_budget_arg(v, k);
     } else {
       throw InvalidInput("unknown option '" + k + "'; options: " + kOptionNames);
     }
@@ -78,12 +70,14 @@ arguments, nothing built): lets a caller refuse a job before it starts.)doc");
 
   m.def(
       "make_exemplar_pair",
-      [](const std::string& preset, int resolution, std::uint64_t seed, ExecContext* ctx, const py::kwargs& kw) {
+      [](const StrArg& preset, const IntArg& resolution, const IntArg& seed, const ContextArg& ctx_arg,
+         const py::kwargs& kw) {
         PairOptions opt;
-        opt.resolution = resolution;
-        opt.seed = seed;
+        opt.resolution = int_arg(resolution, "resolution", kMinPairResolution, kMaxPairResolution, "voxels per grid edge");
+        opt.seed = seed_arg(seed);
+        ExecContext* ctx = context_arg(ctx_arg);
         apply_options(opt, kw);
-        const PairPreset p = to_preset(preset);
+        const PairPreset p = to_preset(string_arg(preset, "preset", "'spikes', 'pits', 'holes', 'grooves' or 'dilate'"));
         ExemplarPair pair;
         {
           py::gil_scoped_release release;
@@ -98,8 +92,7 @@ arguments, nothing built): lets a caller refuse a job before it starts.)doc");
         out["field"] = from_volume(std::move(pair.field_a));
         return out;
       },
-      py::arg("preset") = "spikes", py::kw_only(), py::arg("resolution") = 64, py::arg("seed") = std::uint64_t(0),
-      py::arg("ctx") = static_cast<ExecContext*>(nullptr),
+      py::arg("preset") = "spikes", py::kw_only(), py::arg("resolution") = 64, py::arg("seed") = 0, py::arg("ctx") = py::none(),
       R"doc(A built-in exemplar pair A -> A' (Bhat et al. 2004, Figures 2 and 7) as signed distances.
 
 preset: 'spikes' | 'pits' | 'holes' (a horizontal slab -> with cones on top / spherical dents /

@@ -2,6 +2,7 @@
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 
+#include "arguments.hpp"
 #include "arrays.hpp"
 #include "exsynth/errors.hpp"
 #include "exsynth/solid.hpp"
@@ -13,7 +14,8 @@ namespace {
 
 /// (H, W) or (H, W, C) uint8 / uint16 / float32 / float64 -> Image in [0, 1]
 /// for integer types (8- and 16-bit exemplars), unchanged for floats.
-Image to_image(const py::array& a, const std::string& name) {
+Image to_image(const py::handle& arg, const std::string& name) {
+  const py::array a = array_arg(arg, name, "an (H, W) or (H, W, C) image array");
   if (a.ndim() != 2 && a.ndim() != 3)
     throw InvalidInput("'" + name + "' must be an (H, W) or (H, W, C) image array, got a " + describe(a));
   const int h = int(a.shape(0)), w = int(a.shape(1)), c = a.ndim() == 3 ? int(a.shape(2)) : 1;
@@ -49,29 +51,43 @@ void set_common(TextureOptimizationOptions& o, const py::kwargs& kw) {
   for (auto item : kw) {
     const std::string k = py::str(item.first);
     const py::handle v = item.second;
-    if (k == "levels") o.levels = v.cast<int>();
-    else if (k == "neighborhood") o.neighborhood = v.cast<int>();
-    else if (k == "iterations") o.iterations = v.cast<int>();
-    else if (k == "r") o.r = v.cast<double>();
-    else if (k == "pca_variance") o.pca_variance = v.cast<double>();
-    else if (k == "max_pca_dims") o.max_pca_dims = v.cast<int>();
-    else if (k == "search") o.search = to_search(v.cast<std::string>());
-    else if (k == "coherence_k") o.coherence_k = v.cast<int>();
-    else if (k == "random_candidates") o.random_candidates = v.cast<int>();
-    else if (k == "ann_eps") o.ann_eps = v.cast<double>();
-    else if (k == "histogram_matching") o.histogram_matching = v.cast<bool>();
-    else if (k == "histogram_bins") o.histogram_bins = v.cast<int>();
-    else if (k == "mean_shift") o.mean_shift = v.cast<bool>();
-    else if (k == "feature_weight") o.feature_weight = v.cast<double>();
-    else if (k == "tileable") o.tileable = v.cast<bool>();
-    else if (k == "memory_budget") o.memory_budget = v.cast<std::size_t>() ? v.cast<std::size_t>() : kDefaultMemoryBudget;
-    else if (k == "seed") o.seed = v.cast<std::uint64_t>();
+    // Ranges as solid/synthesize.cpp's check_options (which checks them again).
+    if (k == "levels") o.levels = int_arg(v, k, 1, 8);
+    else if (k == "neighborhood") o.neighborhood = int_arg(v, k, 3, 32);
+    else if (k == "iterations") o.iterations = int_arg(v, k, 1, 100);
+    else if (k == "r") o.r = real_arg(v, k, 0.0, 2.0, Ends::OpenLow);
+    else if (k == "pca_variance") o.pca_variance = real_arg(v, k, 0.0, 1.0, Ends::OpenLow);
+    else if (k == "max_pca_dims") o.max_pca_dims = int_arg(v, k, 1, 4096);
+    else if (k == "search") o.search = to_search(string_arg(v, k, "'kcoherence', 'kdtree' or 'exact'"));
+    else if (k == "coherence_k") o.coherence_k = int_arg(v, k, 0, 64);
+    else if (k == "random_candidates") o.random_candidates = int_arg(v, k, 0, 64);
+    else if (k == "ann_eps") o.ann_eps = real_arg(v, k, 0.0, 1e6);
+    else if (k == "histogram_matching") o.histogram_matching = bool_arg(v, k);
+    else if (k == "histogram_bins") o.histogram_bins = int_arg(v, k, 2, 256);
+    else if (k == "mean_shift") o.mean_shift = bool_arg(v, k);
+    else if (k == "feature_weight") o.feature_weight = real_arg(v, k, 0.0, 100.0, Ends::Closed, "0 = off");
+    else if (k == "tileable") o.tileable = bool_arg(v, k);
+    else if (k == "memory_budget") o.memory_budget = memory_budget_arg(v, k);
+    else if (k == "seed") o.seed = seed_arg(v, k);
     else
       throw InvalidInput("unknown option '" + k +
                          "'; options: levels, neighborhood, iterations, r, pca_variance, max_pca_dims, search, "
                          "coherence_k, random_candidates, ann_eps, histogram_matching, histogram_bins, mean_shift, "
                          "feature_weight, tileable, memory_budget, seed");
   }
+}
+
+/// The last channel of a constraint is a weight in [0, 1] (1 = take the
+/// target); the core only checks finiteness, so a weight of 2 would
+/// silently overshoot the target.
+void check_constraint_weights(const Volume& c) {
+  const int channels = c.channels();
+  if (channels < 2) return;  // the core reports the channel count
+  const std::vector<float>& v = c.values();
+  for (std::size_t i = std::size_t(channels - 1); i < v.size(); i += std::size_t(channels))
+    if (!(v[i] >= 0.0f && v[i] <= 1.0f))
+      throw InvalidInput("'constraint' weights (its last channel) must be in [0, 1] (1 = take the target, 0 = ignore "
+                         "it), got " + std::to_string(v[i]) + " at voxel " + std::to_string(i / std::size_t(channels)));
 }
 
 py::list to_list(const std::vector<double>& v) {
@@ -85,19 +101,25 @@ py::list to_list(const std::vector<double>& v) {
 void bind_solid(py::module_& m) {
   m.def(
       "synthesize_solid",
-      [](const py::array& exemplar, const py::object& exemplar_y, const py::object& exemplar_z, const std::string& views,
-         int size, const py::object& constraint, ExecContext* ctx, const py::kwargs& kw) {
+      [](const ArrayArg& exemplar, const OptionalArrayArg& exemplar_y, const OptionalArrayArg& exemplar_z,
+         const StrArg& views_arg, const IntArg& size, const OptionalArrayArg& constraint, const ContextArg& ctx_arg,
+         const py::kwargs& kw) {
+        const std::string views = string_arg(views_arg, "views", "the active slices, e.g. 'xyz' or 'xy'");
+        ExecContext* ctx = context_arg(ctx_arg);
         SolidExemplars ex;
         ex.views[0] = to_image(exemplar, "exemplar");
-        if (!exemplar_y.is_none()) ex.views[1] = to_image(exemplar_y.cast<py::array>(), "exemplar_y");
-        if (!exemplar_z.is_none()) ex.views[2] = to_image(exemplar_z.cast<py::array>(), "exemplar_z");
+        if (!exemplar_y.is_none()) ex.views[1] = to_image(exemplar_y, "exemplar_y");
+        if (!exemplar_z.is_none()) ex.views[2] = to_image(exemplar_z, "exemplar_z");
         for (int i = 0; i < 3; ++i) ex.active[i] = views.find("xyz"[i]) != std::string::npos;
         for (char c : views)
           if (c != 'x' && c != 'y' && c != 'z')
             throw InvalidInput("views must name the active slices with x, y and z (e.g. 'xyz' or 'xy'), got '" + views + "'");
-        if (!constraint.is_none()) ex.constraint = to_volume(constraint.cast<py::array>(), "constraint", GridTransform{});
+        if (!constraint.is_none()) {
+          ex.constraint = to_volume(constraint, "constraint", GridTransform{});
+          check_constraint_weights(ex.constraint);
+        }
         SolidOptions opt;
-        opt.size = size;
+        opt.size = int_arg(size, "size", 1, 2048, "voxels per edge");
         set_common(opt, kw);
         TextureResult r;
         {
@@ -114,7 +136,7 @@ void bind_solid(py::module_& m) {
       },
       py::arg("exemplar"), py::kw_only(), py::arg("exemplar_y") = py::none(), py::arg("exemplar_z") = py::none(),
       py::arg("views") = "xyz", py::arg("size") = 64, py::arg("constraint") = py::none(),
-      py::arg("ctx") = static_cast<ExecContext*>(nullptr),
+      py::arg("ctx") = py::none(),
       R"doc(Solid texture from 2D exemplars (Kopf et al. 2007).
 
 exemplar: (H, W) or (H, W, C) uint8/uint16 (scaled to [0, 1]) or float; used for every view
@@ -129,11 +151,13 @@ Returns {'solid': (Z, Y, X, C) float32, 'energy': [...], 'energy_level': [...]}.
 
   m.def(
       "synthesize_image",
-      [](const py::array& exemplar, int width, int height, ExecContext* ctx, const py::kwargs& kw) {
+      [](const ArrayArg& exemplar, const IntArg& width, const IntArg& height, const ContextArg& ctx_arg,
+         const py::kwargs& kw) {
+        ExecContext* ctx = context_arg(ctx_arg);
         const Image ex = to_image(exemplar, "exemplar");
         ImageSynthesisOptions opt;
-        opt.width = width;
-        opt.height = height;
+        opt.width = int_arg(width, "width", 1, 16384, "pixels");
+        opt.height = int_arg(height, "height", 1, 16384, "pixels");
         set_common(opt, kw);
         Image img;
         std::vector<double> energy;
@@ -148,7 +172,7 @@ Returns {'solid': (Z, Y, X, C) float32, 'energy': [...], 'energy_level': [...]}.
         return out;
       },
       py::arg("exemplar"), py::kw_only(), py::arg("width") = 128, py::arg("height") = 128,
-      py::arg("ctx") = static_cast<ExecContext*>(nullptr),
+      py::arg("ctx") = py::none(),
       "2D texture optimisation: exemplar -> (height, width, C) float32 image (tileable=True to tile).\n"
       "Same options as synthesize_solid. Returns {'image': ..., 'energy': [...]}.");
 }

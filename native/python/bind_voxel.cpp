@@ -1,6 +1,7 @@
 // exsynth._native.voxelize
 #include <pybind11/pybind11.h>
 
+#include "arguments.hpp"
 #include "arrays.hpp"
 #include "exsynth/voxelize.hpp"
 
@@ -11,17 +12,21 @@ namespace exsynth::py_bind {
 void bind_voxel(py::module_& m) {
   m.def(
       "voxelize",
-      [](const py::array& vertices, const py::array& faces, int resolution, double voxel_size, int padding,
-         int supersample, bool compute_sdf, std::size_t memory_budget, std::uint64_t seed, ExecContext* ctx) {
+      [](const ArrayArg& vertices, const ArrayArg& faces, const IntArg& resolution,
+         const RealArg& voxel_size, const IntArg& padding, const IntArg& supersample,
+         const BoolArg& compute_sdf, const IntArg& memory_budget, const IntArg& seed,
+         const ContextArg& ctx_arg, const py::kwargs& extra) {
+        reject_unknown(extra, "resolution, voxel_size, padding, supersample, compute_sdf, memory_budget, seed, ctx");
         TriangleMesh mesh = to_mesh(vertices, faces);
         VoxelizeOptions opt;
-        opt.resolution = resolution;
-        opt.voxel_size = voxel_size;
-        opt.padding = padding;
-        opt.supersample = supersample;
-        opt.compute_sdf = compute_sdf;
-        opt.memory_budget = memory_budget ? memory_budget : kDefaultMemoryBudget;
-        opt.seed = seed;
+        opt.resolution = int_arg(resolution, "resolution", 1, kMaxVoxelResolution, "voxels along the longest axis");
+        opt.voxel_size = real_arg(voxel_size, "voxel_size", 0.0, kInf, Ends::Closed, "mesh units; 0 = use resolution");
+        opt.padding = int_arg(padding, "padding", 0, kMaxVoxelPadding, "voxels");
+        opt.supersample = int_arg(supersample, "supersample", 1, kMaxSupersample, "sub-rays per voxel edge");
+        opt.compute_sdf = bool_arg(compute_sdf, "compute_sdf");
+        opt.memory_budget = memory_budget_arg(memory_budget);
+        opt.seed = seed_arg(seed);
+        ExecContext* ctx = context_arg(ctx_arg);
         VoxelizeResult r;
         {
           py::gil_scoped_release release;
@@ -37,8 +42,7 @@ void bind_voxel(py::module_& m) {
       },
       py::arg("vertices"), py::arg("faces"), py::kw_only(), py::arg("resolution") = 128, py::arg("voxel_size") = 0.0,
       py::arg("padding") = 2, py::arg("supersample") = 2, py::arg("compute_sdf") = true,
-      py::arg("memory_budget") = std::size_t(0), py::arg("seed") = std::uint64_t(0),
-      py::arg("ctx") = static_cast<ExecContext*>(nullptr),
+      py::arg("memory_budget") = 0, py::arg("seed") = 0, py::arg("ctx") = py::none(),
       R"doc(Voxelize a triangle mesh into density and signed distance.
 
 vertices: V by 3 float32/float64; faces: F by 3 int32/int64 (indices into vertices).

@@ -71,7 +71,7 @@ def test_progress_and_cancel():
 
 @pytest.mark.parametrize("kwargs, exc, words", [
     ({"preset": "bumps"}, _native.InvalidInputError, ["preset", "bumps", "spikes"]),
-    ({"resolution": 4}, _native.InvalidInputError, ["resolution", "8..512"]),
+    ({"resolution": 4}, _native.InvalidInputError, ["resolution", "between 8 and 512"]),
     ({"feature_radius": -1.0}, _native.InvalidInputError, ["feature_radius"]),
     ({"jitter": 0.9}, _native.InvalidInputError, ["jitter"]),
     ({"spacing": "wide"}, _native.InvalidInputError, ["spacing", "number"]),

@@ -33,7 +33,8 @@ def test_vec3_and_multichannel_grids(tmp_path):
     ({}, ["grids", "empty"]),
     ({"d": np.zeros((2, 2), np.float32)}, ["'d'", "(Z, Y, X)"]),
     ({"d": np.full((2, 2, 2), np.nan, np.float32)}, ["'d'", "NaN"]),
-    ({"d": [[1.0]]}, ["'d'", "NumPy"]),
+    ({"d": [[1.0]]}, ["'d'", "(Z, Y, X)"]),  # a list is converted by NumPy, then its shape is checked
+    ({"d": "dense"}, ["'d'", "NumPy array"]),
 ])
 def test_write_vdb_rejects_bad_grids(tmp_path, grids, words):
     with pytest.raises(_native.InvalidInputError) as info:

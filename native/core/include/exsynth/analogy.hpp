@@ -32,6 +32,15 @@
 
 namespace exsynth {
 
+/// Option limits, checked by synthesize_analogy (exported for the bindings' messages).
+struct AnalogyLimits {
+  static constexpr int max_levels = 6;
+  static constexpr int min_fine_size = 3, max_fine_size = 9;      ///< odd
+  static constexpr int min_coarse_size = 1, max_coarse_size = 7;  ///< odd
+  static constexpr int max_sweeps = 8;
+  static constexpr int max_pca_dims = 4096;
+};
+
 struct AnalogyOptions {
   int levels = 2;               ///< Gaussian pyramid levels (coarsest first)
   int fine_size = 5;            ///< edge of the fine neighbourhood cube (odd)

@@ -18,6 +18,10 @@ namespace exsynth {
 void sample_volume(const Volume& vol, const std::vector<Eigen::Vector3f>& points, bool wrap, float* out,
                    ExecContext* ctx = nullptr);
 
+/// Option limits, checked by bake_volume_to_uv.
+constexpr int kMaxBakeSize = 16384;   ///< texels on a side
+constexpr int kMaxBakeMargin = 64;    ///< texels
+
 struct BakeOptions {
   int width = 1024;
   int height = 1024;

@@ -3,6 +3,7 @@
 // thread that watches it (the Blender UI). Every member is thread-safe.
 #include <atomic>
 #include <cstddef>
+#include <functional>
 #include <mutex>
 #include <string>
 
@@ -17,6 +18,7 @@ class ExecContext {
   bool cancelled() const { return cancelled_.load(std::memory_order_relaxed); }
   /// Throws Cancelled if cancel() was called.
   void check() const {
+    if (on_check_) on_check_();
     if (cancelled()) throw Cancelled("cancelled by the user");
   }
 
@@ -40,13 +42,24 @@ class ExecContext {
   double progress() const { return progress_.load(std::memory_order_relaxed); }
 
   void set_stage(std::string stage) {
-    std::lock_guard<std::mutex> lock(mutex_);
-    stage_ = std::move(stage);
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      stage_ = std::move(stage);
+    }
+    if (on_stage_) on_stage_();
   }
   std::string stage() const {
     std::lock_guard<std::mutex> lock(mutex_);
     return stage_;
   }
+
+  /// Hooks for logs and tests (tests/cpp/support/cancel.hpp cancels inside
+  /// a chosen stage with them); set them before the job starts. on_stage:
+  /// on the job's thread whenever a stage starts, after its name is set.
+  /// on_check: at every cancel check, before the flag is read, from any of
+  /// the job's threads (so it must be thread-safe).
+  void on_stage(std::function<void()> hook) { on_stage_ = std::move(hook); }
+  void on_check(std::function<void()> hook) { on_check_ = std::move(hook); }
 
  private:
   std::atomic<bool> cancelled_{false};
@@ -54,6 +67,7 @@ class ExecContext {
   std::atomic<double> span_lo_{0.0}, span_hi_{1.0};
   mutable std::mutex mutex_;
   std::string stage_;
+  std::function<void()> on_stage_, on_check_;
 };
 
 /// One stage of a job: maps `total` units of work onto the progress range
@@ -63,15 +77,22 @@ class StageProgress {
  public:
   StageProgress(ExecContext* ctx, std::string stage, double lo, double hi, std::size_t total)
       : ctx_(ctx), lo_(lo), hi_(hi), total_(total ? total : 1) {
+    // Named before the check, so a cancel that arrives between two stages
+    // is reported at the stage that starts (and seen as such by the hooks).
     if (ctx_) {
-      ctx_->check();
-      ctx_->set_stage(std::move(stage));
       ctx_->set_progress(lo_);
+      ctx_->set_stage(std::move(stage));
+      ctx_->check();
     }
   }
   /// Throws Cancelled when the context was cancelled.
   void check() const {
     if (ctx_) ctx_->check();
+  }
+  /// For serial loops: checks on every 65536th iteration i (i = 0 included),
+  /// cheap enough to call on each.
+  void check_every(std::size_t i) const {
+    if ((i & 0xFFFF) == 0) check();
   }
   void advance(std::size_t units = 1) {
     std::size_t done = done_.fetch_add(units, std::memory_order_relaxed) + units;

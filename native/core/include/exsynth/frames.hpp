@@ -15,6 +15,9 @@
 
 namespace exsynth {
 
+/// Limit of FrameOptions::smoothing_steps (each step is one pass over the volume).
+constexpr int kMaxSmoothingSteps = 1000;
+
 struct FrameOptions {
   double band = 1.5;        ///< surface voxels: |sdf| <= band voxels; their T is fixed from the field
   int smoothing_steps = 4;  ///< fix-and-diffuse steps after the nearest-surface propagation

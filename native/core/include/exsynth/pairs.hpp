@@ -36,6 +36,10 @@ enum class GrooveDirection {
   Along,   ///< straight grooves parallel to the axis (field: +z)
 };
 
+/// Grid resolution limits (make_exemplar_pair checks 8..512; keep them in step).
+constexpr int kMinPairResolution = 8;
+constexpr int kMaxPairResolution = 512;
+
 struct PairOptions {
   int resolution = 64;            ///< voxels per grid edge (8..512); the grid spans [-1, 1]^3
   // ---- slabs (spikes, pits, holes) ----

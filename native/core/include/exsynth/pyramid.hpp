@@ -10,6 +10,9 @@
 
 namespace exsynth {
 
+/// Limit of PyramidOptions::levels (2^31 voxels halve to one in 31 steps).
+constexpr int kMaxPyramidLevels = 32;
+
 struct PyramidOptions {
   int levels = 3;                    ///< number of levels including the input (>= 1)
   Boundary boundary = Boundary::Clamp;  ///< Wrap for tileable (toroidal) data
@@ -20,6 +23,9 @@ std::vector<Image> gaussian_pyramid(const Image& img, const PyramidOptions& opt 
                                     ExecContext* ctx = nullptr);
 std::vector<Volume> gaussian_pyramid(const Volume& vol, const PyramidOptions& opt = {},
                                      ExecContext* ctx = nullptr);
+/// The same as one stage of a longer job: progress goes from lo to hi.
+std::vector<Volume> gaussian_pyramid(const Volume& vol, const PyramidOptions& opt, ExecContext* ctx, double lo,
+                                     double hi);
 
 /// One blur + decimate step (exposed for tests).
 Image downsample(const Image& img, Boundary b);

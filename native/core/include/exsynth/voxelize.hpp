@@ -16,6 +16,11 @@
 
 namespace exsynth {
 
+/// Option limits, checked by voxelize (exported for the bindings' messages).
+constexpr int kMaxVoxelResolution = 1 << 14;
+constexpr int kMaxVoxelPadding = 1024;
+constexpr int kMaxSupersample = 8;
+
 struct VoxelizeOptions {
   int resolution = 128;       ///< voxels along the longest bounding-box axis (when voxel_size == 0)
   double voxel_size = 0.0;    ///< > 0: voxel edge length in mesh units (overrides resolution)

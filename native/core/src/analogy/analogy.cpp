@@ -96,10 +96,12 @@ using Tiles = std::vector<std::vector<std::uint32_t>>;
 // `order`, grouped by the tile's colour (the parity of its x, y and z tile
 // index: 8 colours); tiles of a colour by increasing index.
 std::array<Tiles, 8> tiles_by_colour(const Volume& grid, const std::vector<std::uint32_t>& band,
-                                     const std::vector<std::uint32_t>& order, int edge) {
+                                     const std::vector<std::uint32_t>& order, int edge, const StageProgress& progress) {
   const int tx = (grid.nx() + edge - 1) / edge, ty = (grid.ny() + edge - 1) / edge;
   std::map<std::size_t, std::vector<std::uint32_t>> by_tile;
+  std::size_t n = 0;
   for (const std::uint32_t i : order) {
+    progress.check_every(n++);
     const Vec3 g = voxel_position(grid, band[i]);
     const std::size_t key = (std::size_t(int(g.z()) / edge) * std::size_t(ty) + std::size_t(int(g.y()) / edge)) *
                                 std::size_t(tx) + std::size_t(int(g.x()) / edge);
@@ -122,8 +124,10 @@ std::array<Tiles, 8> tiles_by_colour(const Volume& grid, const std::vector<std::
 void carry_coarse_sources(const Volume& coarse_grid, const std::vector<Vec3>& coarse_source_at, const Volume& bl,
                           const std::vector<std::uint32_t>& band, const std::vector<Frame>& b_frames, const Volume& al,
                           const std::vector<Frame>& a_frames, const std::vector<std::int32_t>& row_of,
-                          std::vector<std::int32_t>& source, std::vector<Vec3>& source_at) {
+                          std::vector<std::int32_t>& source, std::vector<Vec3>& source_at,
+                          const StageProgress& progress) {
   for (std::size_t i = 0; i < band.size(); ++i) {
+    progress.check_every(i);
     const Vec3 g = voxel_position(bl, band[i]);
     const int px = std::min(int(g.x()) / 2, coarse_grid.nx() - 1), py = std::min(int(g.y()) / 2, coarse_grid.ny() - 1),
               pz = std::min(int(g.z()) / 2, coarse_grid.nz() - 1);
@@ -150,14 +154,25 @@ void validate(const Volume& a, const Volume& a_prime, const Volume* field_a, con
   if (a.nx() != a_prime.nx() || a.ny() != a_prime.ny() || a.nz() != a_prime.nz())
     throw InvalidInput("A and A' must have the same size, got " + size_of(a) + " and " + size_of(a_prime) +
                        "; voxelize both on the same grid");
-  if (opt.levels < 1 || opt.levels > 6) throw InvalidInput("levels must be between 1 and 6, got " + std::to_string(opt.levels));
-  if (opt.fine_size < 3 || opt.fine_size > 9 || opt.fine_size % 2 == 0)
-    throw InvalidInput("fine_size must be odd, between 3 and 9, got " + std::to_string(opt.fine_size));
-  if (opt.coarse_size < 1 || opt.coarse_size > 7 || opt.coarse_size % 2 == 0)
-    throw InvalidInput("coarse_size must be odd, between 1 and 7, got " + std::to_string(opt.coarse_size));
-  if (opt.sweeps < 1 || opt.sweeps > 8) throw InvalidInput("sweeps must be between 1 and 8, got " + std::to_string(opt.sweeps));
-  if (!(opt.coherence >= 0) || !(opt.coherence_slack >= 0))
-    throw InvalidInput("coherence and coherence_slack must be >= 0");
+  using Lim = AnalogyLimits;
+  auto range = [](const char* name, int v, int lo, int hi, bool odd) {
+    if (v < lo || v > hi || (odd && v % 2 == 0))
+      throw InvalidInput(std::string(name) + " must be " + (odd ? "odd, " : "") + "between " + std::to_string(lo) +
+                         " and " + std::to_string(hi) + ", got " + std::to_string(v));
+  };
+  range("levels", opt.levels, 1, Lim::max_levels, false);
+  range("fine_size", opt.fine_size, Lim::min_fine_size, Lim::max_fine_size, true);
+  range("coarse_size", opt.coarse_size, Lim::min_coarse_size, Lim::max_coarse_size, true);
+  range("sweeps", opt.sweeps, 1, Lim::max_sweeps, false);
+  range("max_pca_dims", opt.max_pca_dims, 1, Lim::max_pca_dims, false);
+  if (!(opt.pca_variance > 0 && opt.pca_variance <= 1))
+    throw InvalidInput("pca_variance must be in (0, 1], got " + std::to_string(opt.pca_variance));
+  if (!(opt.ann_eps >= 0) || !std::isfinite(opt.ann_eps))
+    throw InvalidInput("ann_eps must be a finite number >= 0, got " + std::to_string(opt.ann_eps));
+  if (!(opt.coherence >= 0) || !(opt.coherence_slack >= 0) || !std::isfinite(opt.coherence) ||
+      !std::isfinite(opt.coherence_slack))
+    throw InvalidInput("coherence and coherence_slack must be finite numbers >= 0");
+  if (!std::isfinite(opt.cull_distance)) throw InvalidInput("cull_distance must be finite (< 0 = automatic, 0 = off)");
   if (b.voxel_count() >= std::size_t(std::numeric_limits<std::uint32_t>::max()) ||
       a.voxel_count() >= std::size_t(std::numeric_limits<std::int32_t>::max()))
     throw InvalidInput("A or B has too many voxels (limit 2^31); use a lower resolution");
@@ -186,10 +201,13 @@ AnalogyResult run(const Volume& a, const Volume& a_prime, const Volume* field_a,
                       opt.memory_budget, "the analogy of a " + size_of(a) + " exemplar onto a " + size_of(b) + " volume",
                       "use a lower resolution or raise the memory budget");
 
+  // Progress: the pyramids, then the levels by their voxel counts, then the debris.
+  constexpr double kPyramidsEnd = 0.03, kLevelsEnd = 0.97;
   PyramidOptions popt;
   popt.levels = L;
-  const std::vector<Volume> pa = gaussian_pyramid(a, popt), pap = gaussian_pyramid(a_prime, popt),
-                            pb = gaussian_pyramid(b, popt);
+  const std::vector<Volume> pa = gaussian_pyramid(a, popt, ctx, 0.0, 0.01),
+                            pap = gaussian_pyramid(a_prime, popt, ctx, 0.01, 0.02),
+                            pb = gaussian_pyramid(b, popt, ctx, 0.02, kPyramidsEnd);
   const Volume no_field;
 
   const Reach reach = pair_reach(a, a_prime);
@@ -208,9 +226,10 @@ AnalogyResult run(const Volume& a, const Volume& a_prime, const Volume* field_a,
     const Volume& al = pa[std::size_t(k)];
     const Volume& apl = pap[std::size_t(k)];
     const Volume& bl = pb[std::size_t(k)];
-    const double p0 = work_done / work_total;
+    const double p0 = kPyramidsEnd + (kLevelsEnd - kPyramidsEnd) * work_done / work_total;
     work_done += double(bl.voxel_count());
-    const double p1 = work_done / work_total;
+    const double p1 = kPyramidsEnd + (kLevelsEnd - kPyramidsEnd) * work_done / work_total;
+    auto share = [&](double f) { return p0 + f * (p1 - p0); };  // a fraction of this level's progress
     const std::string stage = "analogy: level " + std::to_string(l + 1) + "/" + std::to_string(L);
     // Band searched: within the fine half-width of B''s surface plus, at the
     // coarsest level, as far as the pair moves A's surface on each side (a
@@ -234,9 +253,11 @@ AnalogyResult run(const Volume& a, const Volume& a_prime, const Volume* field_a,
     // densities (whichever is smaller).
     const auto [lo, hi] = std::minmax_element(al.values().begin(), al.values().end());
     const float tol = std::min(0.1f * float(al.transform().voxel_size), 0.01f * (*hi - *lo));
-    const std::vector<unsigned char> changed = change_mask(al, apl, tol, opt.fine_size / 2 + 1);
+    StageProgress change(ctx, stage + " exemplar change", share(0.0), share(0.02), 1);
+    const std::vector<unsigned char> changed = change_mask(al, apl, tol, opt.fine_size / 2 + 1, change);
     std::vector<std::uint32_t> a_voxels;
     for (std::uint32_t i = 0; i < std::uint32_t(al.voxel_count()); ++i) {
+      change.check_every(i);
       if (!changed[i] || (cull > 0 && std::abs(al.data()[i]) > 2.0 * cull && std::abs(apl.data()[i]) > 2.0 * cull))
         continue;
       if (!opt.a_region.empty()) {
@@ -251,11 +272,13 @@ AnalogyResult run(const Volume& a, const Volume& a_prime, const Volume* field_a,
                          std::to_string(l + 1) +
                          "; give a pair whose A' changes A there (and A as a signed distance field, or set "
                          "cull_distance=0)");
-    const std::vector<Frame> a_frames = analogy::frames_at(al, aligned ? *field_a : no_field, scale, a_voxels, nullptr);
+    StageProgress a_frame_progress(ctx, stage + " exemplar frames", share(0.02), share(0.04), a_voxels.size());
+    const std::vector<Frame> a_frames =
+        analogy::frames_at(al, aligned ? *field_a : no_field, scale, a_voxels, nullptr, a_frame_progress);
     const int C = int(hood.causal.size()), D = hood.dims(has_coarser);
     RowMatrixXf db(Eigen::Index(a_voxels.size()), D);
     {
-      StageProgress build(ctx, stage + " exemplar features", p0, p0 + 0.1 * (p1 - p0), a_voxels.size());
+      StageProgress build(ctx, stage + " exemplar features", share(0.04), share(0.09), a_voxels.size());
       parallel_chunks(a_voxels.size(), 1024, build, [&](std::size_t begin, std::size_t end) {
         for (std::size_t i = begin; i < end; ++i) {
           const Vec3 g = voxel_position(al, a_voxels[i]);
@@ -265,33 +288,51 @@ AnalogyResult run(const Volume& a, const Volume& a_prime, const Volume* field_a,
         }
       });
     }
+    // PCA, projection and the k-d tree are single library calls: checked
+    // between them (each well under 0.2 s at the sizes the budget allows).
+    StageProgress indexing(ctx, stage + " exemplar index", share(0.09), share(0.1), 3);
     const search::Pca pca = search::fit_pca(db, opt.pca_variance, opt.max_pca_dims);
+    indexing.check();
+    indexing.advance(1);
     const RowMatrixXf coeffs = pca.project(db);
     RowMatrixXf().swap(db);
+    indexing.check();
+    indexing.advance(1);
     const analogy::AnnIndex index(coeffs);
+    indexing.check();
+    indexing.advance(1);
     std::vector<std::int32_t> row_of(al.voxel_count(), -1);
     for (std::size_t i = 0; i < a_voxels.size(); ++i) row_of[a_voxels[i]] = std::int32_t(i);
 
     // ---- B' starts as B at the coarsest level, as the coarser B' upsampled above.
-    Volume bp = has_coarser ? upsample(bp_coarse, bl) : bl;
+    StageProgress band_progress(ctx, stage + " band", share(0.1), share(0.12), std::size_t(bl.nz()) + 1);
+    Volume bp = has_coarser ? upsample(bp_coarse, bl, band_progress) : bl;
     bp.set_transform(bl.transform());
     const Side b_side{&bl, &bp, has_coarser ? &pb[std::size_t(k + 1)] : nullptr, has_coarser ? &bp_coarse : nullptr};
     // Culling looks at B' as it stands, so a surface a coarser level moved
     // (a dilation, a spike) keeps its new place: far voxels stay EMPTY or
     // OPAQUE by their sign.
     std::vector<std::uint32_t> band;
-    for (std::uint32_t i = 0; i < std::uint32_t(bl.voxel_count()); ++i)
+    for (std::uint32_t i = 0; i < std::uint32_t(bl.voxel_count()); ++i) {
+      band_progress.check_every(i);
       if (cull <= 0 || (bp.data()[i] <= cull_out && bp.data()[i] >= -cull_in)) band.push_back(i);
-    const std::vector<Frame> b_frames = analogy::frames_at(bl, aligned ? *field_b : no_field, scale, band, nullptr);
+    }
+    StageProgress b_frame_progress(ctx, stage + " target frames", share(0.12), share(0.14), band.size());
+    const std::vector<Frame> b_frames =
+        analogy::frames_at(bl, aligned ? *field_b : no_field, scale, band, nullptr, b_frame_progress);
 
     // Visit order: scanline (the band is sorted by index) or sweep distance.
     std::vector<std::uint32_t> order(band.size());
     std::iota(order.begin(), order.end(), 0u);
     if (aligned) {
+      const int iterations = has_coarser ? 40 : 400;
+      StageProgress sweep(ctx, stage + " sweep distance", share(0.14), share(0.17), std::size_t(iterations) + 1);
       const std::vector<float> phi =
           analogy::sweep_distance(bl.nx(), bl.ny(), bl.nz(), band, b_frames,
-                                  upsample_phi(phi_coarse, has_phi_coarse, bl, band), has_coarser ? 40 : 400);
+                                  upsample_phi(phi_coarse, has_phi_coarse, bl, band), iterations, sweep);
+      sweep.check();
       std::stable_sort(order.begin(), order.end(), [&](std::uint32_t i, std::uint32_t j) { return phi[i] < phi[j]; });
+      sweep.check();
       phi_coarse = Volume(bl.nx(), bl.ny(), bl.nz(), 1);
       has_phi_coarse = Volume(bl.nx(), bl.ny(), bl.nz(), 1);
       for (std::size_t i = 0; i < band.size(); ++i) {
@@ -309,7 +350,7 @@ AnalogyResult run(const Volume& a, const Volume& a_prime, const Volume* field_a,
     const Eigen::RowVectorXf mean_proj = pca.mean * pca.basis;
     RowMatrixXf fixed(Eigen::Index(band.size()), d);
     {
-      StageProgress prep(ctx, stage + " target features", p0 + 0.1 * (p1 - p0), p0 + 0.2 * (p1 - p0), band.size());
+      StageProgress prep(ctx, stage + " target features", share(0.17), share(0.2), band.size());
       parallel_chunks(band.size(), 1024, prep, [&](std::size_t begin, std::size_t end) {
         Eigen::RowVectorXf f(D - C);
         for (std::size_t i = begin; i < end; ++i) {
@@ -328,9 +369,10 @@ AnalogyResult run(const Volume& a, const Volume& a_prime, const Volume* field_a,
     std::vector<std::int32_t> source(band.size(), -1);
     std::vector<Vec3> source_at(band.size());
     const int nx = bl.nx(), ny = bl.ny(), nz = bl.nz();
+    StageProgress ordering(ctx, stage + " visit order", share(0.2), share(0.2), 1);
     if (has_coarser && opt.coherence > 0)
       carry_coarse_sources(pb[std::size_t(k + 1)], coarse_source_at, bl, band, b_frames, al, a_frames, row_of, source,
-                           source_at);
+                           source_at, ordering);
     const float kappa = float((1.0 + opt.coherence) * (1.0 + opt.coherence));
     const float slack = float(opt.coherence_slack * coeffs.squaredNorm() / double(coeffs.rows()));
     // At the coarsest level a growing pass comes first: B' = B
@@ -347,10 +389,11 @@ AnalogyResult run(const Volume& a, const Volume& a_prime, const Volume* field_a,
     // sweep order itself has a local minimum wherever the field circles, and
     // every minimum would start a copy of its own.)
     std::vector<std::uint32_t> grow_order;
-    if (grow) grow_order = breadth_first(bl, band, band_of, order);
+    if (grow) grow_order = breadth_first(bl, band, band_of, order, ordering);
+    const std::array<Tiles, 8> tiles = tiles_by_colour(bl, band, order, kTile, ordering);
     const std::size_t passes = std::size_t(opt.sweeps + (grow ? 1 : 0));
     result.culled += passes * (bl.voxel_count() - band.size());
-    StageProgress synth(ctx, stage + " synthesis", p0 + 0.2 * (p1 - p0), p1, passes * band.size());
+    StageProgress synth(ctx, stage + " synthesis", share(0.2), p1, passes * band.size());
     // One visit: the voxel at band position i takes its best candidate.
     // Reads B' and the sources within a few voxels, writes only its own.
     const auto visit = [&](std::uint32_t i, bool growing, Scratch& sc) {
@@ -449,7 +492,6 @@ AnalogyResult run(const Volume& a, const Volume& a_prime, const Volume* field_a,
     // one colour (the parity of their x, y, z tile index) are a tile apart,
     // farther than any visit reads, so they run in parallel and the result
     // does not depend on the number of threads; the colours run in turn.
-    const std::array<Tiles, 8> tiles = tiles_by_colour(bl, band, order, kTile);
     tbb::enumerable_thread_specific<Scratch> scratch([&] { return Scratch(C, d); });
     for (int sweep = 0; sweep < opt.sweeps; ++sweep)
       for (const Tiles& colour : tiles) {
@@ -474,7 +516,10 @@ AnalogyResult run(const Volume& a, const Volume& a_prime, const Volume* field_a,
   }
   result.b_prime = std::move(bp_coarse);
   result.b_prime.set_transform(b.transform());
-  if (opt.remove_debris) result.debris = analogy::remove_debris(result.b_prime, b);
+  if (opt.remove_debris) {
+    StageProgress debris(ctx, "analogy: debris", kLevelsEnd, 1.0, 2);
+    result.debris = analogy::remove_debris(result.b_prime, b, debris);
+  }
   if (ctx) ctx->set_progress(1.0);
   return result;
 }

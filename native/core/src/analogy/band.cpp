@@ -7,7 +7,7 @@ namespace exsynth::analogy {
 
 std::vector<std::uint32_t> breadth_first(const Volume& grid, const std::vector<std::uint32_t>& band,
                                          const std::vector<std::int32_t>& band_of,
-                                         const std::vector<std::uint32_t>& order) {
+                                         const std::vector<std::uint32_t>& order, const StageProgress& progress) {
   std::vector<std::uint32_t> out;
   out.reserve(band.size());
   std::vector<unsigned char> seen(band.size(), 0);
@@ -17,6 +17,7 @@ std::vector<std::uint32_t> breadth_first(const Volume& grid, const std::vector<s
     std::size_t head = out.size();
     out.push_back(start);
     while (head < out.size()) {
+      progress.check_every(head);
       const Vec3 g = voxel_position(grid, band[out[head++]]);
       const int x = int(g.x()), y = int(g.y()), z = int(g.z());
       for (int dz = -1; dz <= 1; ++dz)
@@ -34,10 +35,9 @@ std::vector<std::uint32_t> breadth_first(const Volume& grid, const std::vector<s
   return out;
 }
 
-Volume upsample(const Volume& coarse, const Volume& like) {
+Volume upsample(const Volume& coarse, const Volume& like, StageProgress& progress) {
   Volume out(like.nx(), like.ny(), like.nz(), 1, 0.0f, like.transform());
-  StageProgress quiet(nullptr, {}, 0.0, 0.0, std::size_t(like.nz()));
-  parallel_chunks(std::size_t(like.nz()), 1, quiet, [&](std::size_t z0, std::size_t z1) {
+  parallel_chunks(std::size_t(like.nz()), 1, progress, [&](std::size_t z0, std::size_t z1) {
     for (int z = int(z0); z < int(z1); ++z)
       for (int y = 0; y < like.ny(); ++y)
         for (int x = 0; x < like.nx(); ++x) out.at(x, y, z) = trilinear(coarse, 0.5f * x, 0.5f * y, 0.5f * z);

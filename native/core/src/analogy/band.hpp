@@ -4,18 +4,20 @@
 #include <cstdint>
 #include <vector>
 
+#include "exsynth/exec_context.hpp"
 #include "exsynth/grid.hpp"
 
 namespace exsynth::analogy {
 
 // Band positions in breadth-first order over 26-neighbours within the band,
-// each piece started from its first position in `order`.
+// each piece started from its first position in `order`. (Each of these
+// checks `progress` for a cancel at chunk granularity.)
 std::vector<std::uint32_t> breadth_first(const Volume& grid, const std::vector<std::uint32_t>& band,
                                          const std::vector<std::int32_t>& band_of,
-                                         const std::vector<std::uint32_t>& order);
+                                         const std::vector<std::uint32_t>& order, const StageProgress& progress);
 
 // The coarser level's volume on this level's grid (coarse index = index / 2).
-Volume upsample(const Volume& coarse, const Volume& like);
+Volume upsample(const Volume& coarse, const Volume& like, StageProgress& progress);
 
 // The coarser level's sweep distance at this level's voxels (x2: voxel
 // units halve), averaged over the coarse corners that have one; empty when

@@ -14,13 +14,15 @@ struct Parts {
 };
 
 // 6-connected parts of one side (inside: sdf < 0, or outside) of bp.
-Parts parts_of(const Volume& bp, const Volume& b, bool inside) {
+Parts parts_of(const Volume& bp, const Volume& b, bool inside, StageProgress& progress) {
   const int nx = bp.nx(), ny = bp.ny(), nz = bp.nz();
   Parts p;
   p.label.assign(bp.voxel_count(), -1);
   std::vector<std::uint32_t> stack;
   auto side = [&](const Volume& v, std::size_t i) { return (v.data()[i] < 0) == inside; };
+  std::size_t visited = 0;  // voxels taken off the stack, for the cancel checks
   for (std::size_t seed = 0; seed < p.label.size(); ++seed) {
+    progress.check_every(seed);
     if (p.label[seed] >= 0 || !side(bp, seed)) continue;
     const auto id = std::int32_t(p.size.size());
     p.size.push_back(0);
@@ -30,6 +32,7 @@ Parts parts_of(const Volume& bp, const Volume& b, bool inside) {
     while (!stack.empty()) {
       const std::uint32_t i = stack.back();
       stack.pop_back();
+      progress.check_every(++visited);
       ++p.size.back();
       if (side(b, i)) p.anchored.back() = 1;
       const int x = int(i % std::uint32_t(nx)), y = int((i / std::uint32_t(nx)) % std::uint32_t(ny)),
@@ -50,11 +53,11 @@ Parts parts_of(const Volume& bp, const Volume& b, bool inside) {
 
 }  // namespace
 
-std::size_t remove_debris(Volume& b_prime, const Volume& b) {
+std::size_t remove_debris(Volume& b_prime, const Volume& b, StageProgress& progress) {
   const float half = 0.5f * float(b_prime.transform().voxel_size);
   std::size_t changed = 0;
   for (const bool inside : {true, false}) {
-    const Parts p = parts_of(b_prime, b, inside);
+    const Parts p = parts_of(b_prime, b, inside, progress);
     if (p.size.empty()) continue;
     // Crumbs: parts under 0.2 % of the largest (at least 27 voxels) go too,
     // even when they touch B: a sliver a groove cut off, a one-voxel bubble.
@@ -68,6 +71,7 @@ std::size_t remove_debris(Volume& b_prime, const Volume& b) {
       v = inside ? std::max(-v, half) : std::min(-v, -half);
       ++changed;
     }
+    progress.advance(1);
   }
   return changed;
 }

@@ -17,7 +17,8 @@ Reach pair_reach(const Volume& a, const Volume& ap) {
   return r;
 }
 
-std::vector<unsigned char> change_mask(const Volume& a, const Volume& ap, float tol, int r) {
+std::vector<unsigned char> change_mask(const Volume& a, const Volume& ap, float tol, int r,
+                                       const StageProgress& progress) {
   const int nx = a.nx(), ny = a.ny(), nz = a.nz();
   std::vector<unsigned char> m(a.voxel_count()), tmp(a.voxel_count());
   for (std::size_t i = 0; i < m.size(); ++i) m[i] = std::abs(ap.data()[i] - a.data()[i]) > tol;
@@ -25,7 +26,8 @@ std::vector<unsigned char> change_mask(const Volume& a, const Volume& ap, float 
   const int dims[3] = {nx, ny, nz};
   const std::size_t stride[3] = {1, std::size_t(nx), std::size_t(nx) * ny};
   for (int axis = 0; axis < 3; ++axis) {
-    for (int z = 0; z < nz; ++z)
+    for (int z = 0; z < nz; ++z) {
+      progress.check();
       for (int y = 0; y < ny; ++y)
         for (int x = 0; x < nx; ++x) {
           const int c[3] = {x, y, z};
@@ -37,6 +39,7 @@ std::vector<unsigned char> change_mask(const Volume& a, const Volume& ap, float 
           }
           tmp[i] = v;
         }
+    }
     m.swap(tmp);
   }
   return m;

@@ -2,6 +2,7 @@
 // What the pair A -> A' changes, and where. Private to the analogy.
 #include <vector>
 
+#include "exsynth/exec_context.hpp"
 #include "exsynth/grid.hpp"
 
 namespace exsynth::analogy {
@@ -14,7 +15,9 @@ struct Reach {
 };
 Reach pair_reach(const Volume& a, const Volume& ap);
 
-// 1 where |A' - A| > tol, dilated by r voxels (a cube).
-std::vector<unsigned char> change_mask(const Volume& a, const Volume& ap, float tol, int r);
+// 1 where |A' - A| > tol, dilated by r voxels (a cube). Checks `progress`
+// for a cancel once per slice.
+std::vector<unsigned char> change_mask(const Volume& a, const Volume& ap, float tol, int r,
+                                       const StageProgress& progress);
 
 }  // namespace exsynth::analogy

@@ -13,18 +13,42 @@
 #include "grid/gradient.hpp"
 
 namespace exsynth::analogy {
+namespace {
+
+// Eigen's diagonal (Jacobi) preconditioner, applied once per CG iteration:
+// the one place inside Eigen's solver loop where a cancel can be checked
+// without changing a single operation of the solve.
+class CancellablePreconditioner : public Eigen::DiagonalPreconditioner<double> {
+ public:
+  void watch(StageProgress* progress) { progress_ = progress; }
+  template <class Rhs>
+  auto solve(const Eigen::MatrixBase<Rhs>& b) const {
+    if (progress_) {
+      progress_->check();
+      progress_->advance(1);
+    }
+    return Eigen::DiagonalPreconditioner<double>::solve(b);
+  }
+
+ private:
+  StageProgress* progress_ = nullptr;
+};
+
+}  // namespace
 
 std::vector<Frame> frames_at(const Volume& sdf, const Volume& field, int scale,
-                             const std::vector<std::uint32_t>& voxels, std::size_t* bad_count) {
+                             const std::vector<std::uint32_t>& voxels, std::size_t* bad_count,
+                             StageProgress& progress) {
   std::vector<Frame> frames(voxels.size(), Frame::Identity());
-  if (field.empty()) {
+  if (field.empty()) {  // the global frame: nothing to compute
+    progress.check();
+    progress.advance(voxels.size());
     if (bad_count) *bad_count = 0;
     return frames;
   }
   const int nx = sdf.nx(), ny = sdf.ny();
   std::vector<unsigned char> bad(voxels.size(), 0);
-  StageProgress quiet(nullptr, {}, 0.0, 0.0, voxels.size());
-  parallel_chunks(voxels.size(), 4096, quiet, [&](std::size_t begin, std::size_t end) {
+  parallel_chunks(voxels.size(), 4096, progress, [&](std::size_t begin, std::size_t end) {
     for (std::size_t i = begin; i < end; ++i) {
       const std::uint32_t v = voxels[i];
       const int x = int(v % std::uint32_t(nx)), y = int((v / std::uint32_t(nx)) % std::uint32_t(ny)),
@@ -50,7 +74,7 @@ std::vector<Frame> frames_at(const Volume& sdf, const Volume& field, int scale,
 
 std::vector<float> sweep_distance(int nx, int ny, int nz, const std::vector<std::uint32_t>& voxels,
                                   const std::vector<Frame>& frames, const std::vector<float>& guess,
-                                  int iterations) {
+                                  int iterations, StageProgress& progress) {
   const std::size_t n = voxels.size();
   std::vector<float> phi(n, 0.0f);
   if (n == 0) return phi;
@@ -66,6 +90,7 @@ std::vector<float> sweep_distance(int nx, int ny, int nz, const std::vector<std:
   Eigen::VectorXd rhs = Eigen::VectorXd::Zero(Eigen::Index(n));
   const std::uint32_t step[3] = {1u, std::uint32_t(nx), std::uint32_t(nx) * std::uint32_t(ny)};
   for (std::size_t i = 0; i < n; ++i) {
+    progress.check_every(i);
     const std::uint32_t v = voxels[i];
     const int c[3] = {int(v % std::uint32_t(nx)), int((v / std::uint32_t(nx)) % std::uint32_t(ny)),
                       int(v / (std::uint32_t(nx) * std::uint32_t(ny)))};
@@ -86,10 +111,12 @@ std::vector<float> sweep_distance(int nx, int ny, int nz, const std::vector<std:
   }
   Eigen::SparseMatrix<double> lap{Eigen::Index(n), Eigen::Index(n)};
   lap.setFromTriplets(triplets.begin(), triplets.end());
-  Eigen::ConjugateGradient<Eigen::SparseMatrix<double>, Eigen::Lower | Eigen::Upper> cg;
+  progress.check();
+  Eigen::ConjugateGradient<Eigen::SparseMatrix<double>, Eigen::Lower | Eigen::Upper, CancellablePreconditioner> cg;
   cg.setMaxIterations(iterations);
   cg.setTolerance(1e-5);
   cg.compute(lap);
+  cg.preconditioner().watch(&progress);
   Eigen::VectorXd x0 = Eigen::VectorXd::Zero(Eigen::Index(n));
   if (guess.size() == n)
     for (std::size_t i = 0; i < n; ++i) x0[Eigen::Index(i)] = guess[i];

@@ -7,6 +7,7 @@
 
 #include <Eigen/Core>
 
+#include "exsynth/exec_context.hpp"
 #include "exsynth/grid.hpp"
 
 namespace exsynth::analogy {
@@ -41,16 +42,18 @@ inline float trilinear(const Volume& v, float x, float y, float z) {
 /// Returns false in *bad (the voxel's index) when the field is zero or not
 /// finite at a voxel; the frame there falls back to an arbitrary tangent.
 std::vector<Frame> frames_at(const Volume& sdf, const Volume& field, int scale,
-                             const std::vector<std::uint32_t>& voxels, std::size_t* bad_count);
+                             const std::vector<std::uint32_t>& voxels, std::size_t* bad_count,
+                             StageProgress& progress);
 
 /// Sweep distance at the given voxels (sorted by index) of a grid of
 /// nx x ny x nz: least-squares phi with grad phi = T (voxel units) over the
 /// voxels' 6-neighbour graph, by conjugate gradient from `guess` (empty =
 /// zeros) for at most `iterations` steps, so that visiting voxels by
 /// increasing phi moves along the field (the paper's sweep distance; across
-/// the surface T has no component, so phi is constant along N).
+/// the surface T has no component, so phi is constant along N). `progress`
+/// (total: iterations + 1) is checked for a cancel on every iteration.
 std::vector<float> sweep_distance(int nx, int ny, int nz, const std::vector<std::uint32_t>& voxels,
                                   const std::vector<Frame>& frames, const std::vector<float>& guess,
-                                  int iterations);
+                                  int iterations, StageProgress& progress);
 
 }  // namespace exsynth::analogy

@@ -67,10 +67,11 @@ BakeResult bake_volume_to_uv(const Volume& vol, const std::vector<std::array<Eig
                              const std::vector<std::array<Eigen::Vector2f, 3>>& uvs, const BakeOptions& opt,
                              ExecContext* ctx) {
   check_volume(vol);
-  if (opt.width < 1 || opt.height < 1 || opt.width > 16384 || opt.height > 16384)
-    throw InvalidInput("the bake image must be between 1 and 16384 texels on a side, got " + std::to_string(opt.width) +
+  if (opt.width < 1 || opt.height < 1 || opt.width > kMaxBakeSize || opt.height > kMaxBakeSize)
+    throw InvalidInput("the bake image must be between 1 and " + std::to_string(kMaxBakeSize) + " texels on a side, got " + std::to_string(opt.width) +
                        "x" + std::to_string(opt.height));
-  if (opt.margin < 0 || opt.margin > 64) throw InvalidInput("margin must be between 0 and 64 texels");
+  if (opt.margin < 0 || opt.margin > kMaxBakeMargin)
+    throw InvalidInput("margin must be between 0 and " + std::to_string(kMaxBakeMargin) + " texels");
   if (positions.size() != uvs.size())
     throw InvalidInput("positions and uvs must describe the same triangles (" + std::to_string(positions.size()) +
                        " vs " + std::to_string(uvs.size()) + ")");

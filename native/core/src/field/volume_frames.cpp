@@ -51,8 +51,9 @@ VolumeFrames volume_frames(const Volume& sdf, const std::vector<Eigen::Vector3f>
   for (std::size_t i = 0; i < points.size(); ++i)
     if (!points[i].allFinite() || !vectors[i].allFinite())
       throw InvalidInput("field point " + std::to_string(i) + " is not finite; fix the field first");
-  if (!(opt.band > 0) || opt.smoothing_steps < 0)
-    throw InvalidInput("band must be > 0 voxels and smoothing_steps >= 0");
+  if (!(opt.band > 0) || !std::isfinite(opt.band) || opt.smoothing_steps < 0 || opt.smoothing_steps > kMaxSmoothingSteps)
+    throw InvalidInput("band must be a finite number > 0 (voxels) and smoothing_steps between 0 and " +
+                       std::to_string(kMaxSmoothingSteps));
 
   const int nx = sdf.nx(), ny = sdf.ny(), nz = sdf.nz();
   const std::size_t voxels = sdf.voxel_count();
@@ -72,8 +73,10 @@ VolumeFrames volume_frames(const Volume& sdf, const std::vector<Eigen::Vector3f>
   // Surface voxels take the field of their nearest field point.
   RowMatrixXf cloud(Eigen::Index(points.size()), 3);
   for (std::size_t i = 0; i < points.size(); ++i) cloud.row(Eigen::Index(i)) = points[i].transpose();
+  StageProgress field_index(ctx, "frames: field index", 0.2, 0.2, 1);
   Tree tree(3, std::cref(cloud), 16);
   tree.index->buildIndex();
+  field_index.check();
   std::vector<float> dist2(voxels, voxel::kFarAway);
   std::vector<std::int32_t> label(voxels, -1);
   StageProgress surface(ctx, "frames: surface field", 0.2, 0.5, voxels);
@@ -105,6 +108,7 @@ VolumeFrames volume_frames(const Volume& sdf, const std::vector<Eigen::Vector3f>
   voxel::distance_transform(nx, ny, nz, dist2, label, spread);
   std::vector<std::uint8_t> fixed(voxels);
   for (std::size_t v = 0; v < voxels; ++v) {
+    spread.check_every(v);
     fixed[v] = label[v] == std::int32_t(v);
     if (!fixed[v]) set3(f.t, v, get3(f.t, std::size_t(label[v])));
   }

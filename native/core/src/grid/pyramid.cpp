@@ -94,8 +94,9 @@ Volume downsample_impl(const Volume& vol, Boundary b, ExecContext* ctx, double l
 }
 
 void check_levels(int levels) {
-  if (levels < 1) {
-    throw InvalidInput("pyramid 'levels' must be at least 1 (got " + std::to_string(levels) + ")");
+  if (levels < 1 || levels > kMaxPyramidLevels) {
+    throw InvalidInput("pyramid 'levels' must be between 1 and " + std::to_string(kMaxPyramidLevels) + " (got " +
+                       std::to_string(levels) + ")");
   }
 }
 
@@ -138,6 +139,11 @@ std::vector<Image> gaussian_pyramid(const Image& img, const PyramidOptions& opt,
 }
 
 std::vector<Volume> gaussian_pyramid(const Volume& vol, const PyramidOptions& opt, ExecContext* ctx) {
+  return gaussian_pyramid(vol, opt, ctx, 0.0, 1.0);
+}
+
+std::vector<Volume> gaussian_pyramid(const Volume& vol, const PyramidOptions& opt, ExecContext* ctx, double lo,
+                                     double hi) {
   check_levels(opt.levels);
   if (vol.empty()) throw InvalidInput("cannot build a pyramid of an empty volume");
   std::vector<double> work;
@@ -152,7 +158,8 @@ std::vector<Volume> gaussian_pyramid(const Volume& vol, const PyramidOptions& op
   levels.reserve(std::size_t(opt.levels));
   levels.push_back(vol);
   for (int l = 1; l < opt.levels; ++l) {
-    levels.push_back(downsample_impl(levels.back(), opt.boundary, ctx, bounds[l - 1], bounds[l]));
+    levels.push_back(downsample_impl(levels.back(), opt.boundary, ctx, lo + (hi - lo) * bounds[l - 1],
+                                     lo + (hi - lo) * bounds[l]));
   }
   return levels;
 }

@@ -16,19 +16,17 @@
 namespace exsynth {
 namespace {
 
-constexpr int kMaxResolution = 1 << 14;
-
 void validate_options(const VoxelizeOptions& opt) {
   if (!std::isfinite(opt.voxel_size) || opt.voxel_size < 0)
     throw InvalidInput("voxel_size must be a finite number >= 0 (0 means: use resolution), got " +
                        format_number(opt.voxel_size));
-  if (opt.voxel_size == 0 && (opt.resolution < 1 || opt.resolution > kMaxResolution))
-    throw InvalidInput("resolution must be between 1 and " + std::to_string(kMaxResolution) +
+  if (opt.voxel_size == 0 && (opt.resolution < 1 || opt.resolution > kMaxVoxelResolution))
+    throw InvalidInput("resolution must be between 1 and " + std::to_string(kMaxVoxelResolution) +
                        " voxels along the longest axis, got " + std::to_string(opt.resolution));
-  if (opt.padding < 0 || opt.padding > 1024)
-    throw InvalidInput("padding must be between 0 and 1024 voxels, got " + std::to_string(opt.padding));
-  if (opt.supersample < 1 || opt.supersample > 8)
-    throw InvalidInput("supersample must be between 1 and 8 sub-rays per voxel edge, got " +
+  if (opt.padding < 0 || opt.padding > kMaxVoxelPadding)
+    throw InvalidInput("padding must be between 0 and " + std::to_string(kMaxVoxelPadding) + " voxels, got " + std::to_string(opt.padding));
+  if (opt.supersample < 1 || opt.supersample > kMaxSupersample)
+    throw InvalidInput("supersample must be between 1 and " + std::to_string(kMaxSupersample) + " sub-rays per voxel edge, got " +
                        std::to_string(opt.supersample));
 }
 
@@ -60,9 +58,9 @@ VoxelGridSpec voxel_grid_spec(const TriangleMesh& mesh, const VoxelizeOptions& o
   int* dims[3] = {&g.nx, &g.ny, &g.nz};
   for (int k = 0; k < 3; ++k) {
     const double cells = std::ceil(extent[k] / h - 1e-9);
-    if (cells > kMaxResolution)
+    if (cells > kMaxVoxelResolution)
       throw InvalidInput("voxel_size " + format_number(h) + " gives " + std::to_string(long(cells)) +
-                         " voxels along an axis (max " + std::to_string(kMaxResolution) + "); use a larger voxel_size");
+                         " voxels along an axis (max " + std::to_string(kMaxVoxelResolution) + "); use a larger voxel_size");
     *dims[k] = std::max(1, int(cells)) + 2 * opt.padding;
     // Centre the grid on the bounding box.
     g.transform.origin[k] = 0.5 * (lo[k] + hi[k]) - 0.5 * (*dims[k] - 1) * h;
@@ -93,7 +91,8 @@ VoxelizeResult voxelize(const TriangleMesh& input, const VoxelizeOptions& opt, E
   }
 
   StageProgress build(ctx, "voxelize: ray scene", 0.0, 0.05, 1);
-  voxel::AxisRayCaster caster(mesh);
+  voxel::AxisRayCaster caster(mesh);  // one Embree build: checked after it
+  build.check();
   build.advance();
 
   // Ray stabbing along each axis: S x S sub-rays per line give the exact 1-D

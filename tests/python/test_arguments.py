@@ -1,0 +1,272 @@
+"""Every argument of every function of exsynth._native is checked before the engine runs.
+
+A wrong type or an out-of-range number must raise InvalidInputError (a ValueError) naming the
+argument and its valid range -- never pybind11's TypeError with a signature dump (which also
+prints every array passed), an OverflowError or "Unable to cast".
+"""
+import math
+
+import numpy as np
+import pytest
+
+from exsynth import _native
+
+from conftest import box
+
+VERTS, FACES = box()
+SDF = np.linspace(-1, 1, 6 * 6 * 6, dtype=np.float32).reshape(6, 6, 6)
+VOL = np.ones((4, 4, 4), np.float32)
+POS = np.array([[[0, 0, 0], [1, 0, 0], [0, 1, 0]]], np.float32)
+UVS = np.array([[[0.25, 0.25], [0.5, 0.25], [0.25, 0.5]]], np.float32)
+IMG = np.random.default_rng(0).random((16, 16, 3)).astype(np.float32)
+PTS = np.array([[0, 0, 0], [1, 1, 1]], np.float32)
+DIRS = np.array([[1, 0, 0], [1, 0, 0]], np.float32)
+GIVEN = np.zeros_like(VERTS)
+GIVEN[1] = [1, 0, 0]
+
+
+def call(name, *args, **kwargs):
+    return lambda **over: getattr(_native, name)(*args, **{**kwargs, **over})
+
+
+# function -> (a call with valid arguments taking overrides, {argument: kind})
+# kinds: ("int", lo, hi), "seed", "budget", ("real", lo, hi) with None = unbounded,
+# "bool", "ctx", "str".
+FUNCTIONS = {
+    "voxelize": (call("voxelize", VERTS, FACES), {
+        "resolution": ("int", 1, 16384), "padding": ("int", 0, 1024), "supersample": ("int", 1, 8),
+        "voxel_size": ("real", 0, None), "compute_sdf": "bool", "memory_budget": "budget", "seed": "seed",
+        "ctx": "ctx"}),
+    "volume_frames": (call("volume_frames", SDF, [0, 0, 0], 1.0, PTS, DIRS), {
+        "band": ("real", 0, None), "smoothing_steps": ("int", 0, 1000), "ctx": "ctx"}),
+    "synthesize_analogy": (call("synthesize_analogy", SDF, SDF, SDF), {
+        "voxel_size": ("real", 0, None), "levels": ("int", 1, 6), "fine_size": ("int", 3, 9),
+        "coarse_size": ("int", 1, 7), "sweeps": ("int", 1, 8), "pca_variance": ("real", 0, 1),
+        "max_pca_dims": ("int", 1, 4096), "ann_eps": ("real", 0, None), "coherence": ("real", 0, None),
+        "coherence_slack": ("real", 0, None), "cull_distance": ("real", None, None), "remove_debris": "bool",
+        "memory_budget": "budget", "seed": "seed", "ctx": "ctx"}),
+    "sample_volume": (call("sample_volume", VOL, [0, 0, 0], 1.0, PTS), {"wrap": "bool", "ctx": "ctx"}),
+    "bake_volume_to_uv": (call("bake_volume_to_uv", VOL, [0, 0, 0], 1.0, POS, UVS, width=8, height=8), {
+        "width": ("int", 1, 16384), "height": ("int", 1, 16384), "margin": ("int", 0, 64), "wrap": "bool",
+        "ctx": "ctx"}),
+    "isosurface": (call("isosurface", SDF, [0, 0, 0], voxel_size=1.0), {
+        "voxel_size": ("real", 0, None), "isovalue": ("real", None, None), "adaptivity": ("real", 0, 1),
+        "invert": "bool", "ctx": "ctx"}),
+    "gaussian_pyramid": (call("gaussian_pyramid", VOL), {"levels": ("int", 1, 32), "wrap": "bool", "ctx": "ctx"}),
+    "synthesize_solid": (call("synthesize_solid", IMG, size=8, levels=1, iterations=1), {
+        "size": ("int", 1, 2048), "views": "str", "levels": ("int", 1, 8), "neighborhood": ("int", 3, 32),
+        "iterations": ("int", 1, 100), "r": ("real", 0, 2), "pca_variance": ("real", 0, 1),
+        "max_pca_dims": ("int", 1, 4096), "search": "str", "coherence_k": ("int", 0, 64),
+        "random_candidates": ("int", 0, 64), "ann_eps": ("real", 0, 1e6), "histogram_matching": "bool",
+        "histogram_bins": ("int", 2, 256), "mean_shift": "bool", "feature_weight": ("real", 0, 100),
+        "tileable": "bool", "memory_budget": "budget", "seed": "seed", "ctx": "ctx"}),
+    "synthesize_image": (call("synthesize_image", IMG, width=8, height=8, levels=1, iterations=1), {
+        "width": ("int", 1, 16384), "height": ("int", 1, 16384), "levels": ("int", 1, 8), "r": ("real", 0, 2),
+        "memory_budget": "budget", "seed": "seed", "tileable": "bool", "ctx": "ctx"}),
+    "diffuse_direction_field": (call("diffuse_direction_field", VERTS, FACES, GIVEN), {
+        "weights": "str", "seed": "seed", "ctx": "ctx"}),
+    "preset_direction_field": (call("preset_direction_field", VERTS, FACES), {"preset": "str", "ctx": "ctx"}),
+    "make_exemplar_pair": (call("make_exemplar_pair", preset="dilate", resolution=8), {
+        "preset": "str", "resolution": ("int", 8, 512), "thickness": ("real", 0, None),
+        "spacing": ("real", 0, None), "jitter": ("real", 0, 0.25), "dilation": ("real", 0, None),
+        "groove_direction": "str", "memory_budget": "budget", "seed": "seed", "ctx": "ctx"}),
+}
+
+
+def fmt(x):
+    return f"{x:.10g}"
+
+
+def bad_values(kind):
+    """(value, words the message must contain) for an argument of this kind."""
+    if kind == "seed":
+        rng = "between 0 and 2**64 - 1"
+        return [(-1, [rng, "-1"]), (2 ** 64, [rng]), (1.5, [rng, "float"]), ("7", [rng, "str"]), (None, [rng])]
+    if kind == "budget":
+        return [(-1, ["between 0 and", "bytes"]), (2 ** 63, ["between 0 and"]), (1e30, ["integer", "float"]),
+                (math.inf, ["integer"]), ("8G", ["integer", "str"])]
+    if kind == "bool":
+        return [("yes", ["True or False"]), (2, ["True or False"]), (None, ["True or False"])]
+    if kind == "ctx":
+        return [(5, ["ExecContext or None"]), ("ctx", ["ExecContext or None"])]
+    if kind == "str":
+        return [(5, ["a string"]), (None, ["a string"])]
+    if kind[0] == "int":
+        _, lo, hi = kind
+        rng = f"an integer between {lo} and {hi}"
+        return [(lo - 1, [rng]), (hi + 1, [rng]), (2 ** 31, [rng]), (-2 ** 64, [rng]), (2.5, [rng, "float"]),
+                ("8", [rng, "str"]), (None, [rng])]
+    _, lo, hi = kind
+    rng = "a number in" if lo is not None and hi is not None else "a finite number"
+    out = [(math.nan, [rng]), (math.inf, [rng]), ("1", [rng, "str"]), (None, [rng, "None"]), (10 ** 400, [rng])]
+    if lo is not None:
+        out.append((lo - 1, [fmt(lo)]))
+    if hi is not None:
+        out.append((hi + 1, [fmt(hi)]))
+    return out
+
+
+CASES = [(fn, arg, value, words)
+         for fn, (_, args) in FUNCTIONS.items()
+         for arg, kind in args.items()
+         for value, words in bad_values(kind)]
+
+
+@pytest.mark.parametrize("fn, arg, value, words", CASES,
+                         ids=[f"{c[0]}-{c[1]}-{c[2]!r}"[:80] for c in CASES])
+def test_bad_argument_is_an_invalid_input_error_naming_it(fn, arg, value, words):
+    run, _ = FUNCTIONS[fn]
+    with pytest.raises(_native.InvalidInputError) as info:
+        run(**{arg: value})
+    msg = str(info.value)
+    assert f"'{arg}'" in msg or arg in msg, msg
+    for w in words:
+        assert w in msg, msg
+    assert "incompatible function arguments" not in msg and "Unable to cast" not in msg
+    assert len(msg) < 400, msg  # no dump of the arrays passed
+
+
+@pytest.mark.parametrize("fn", sorted(FUNCTIONS))
+def test_a_misspelt_keyword_is_named_with_the_options(fn):
+    run, args = FUNCTIONS[fn]
+    with pytest.raises(_native.InvalidInputError) as info:
+        run(resolutoin=3)
+    msg = str(info.value)
+    assert "unknown option 'resolutoin'" in msg and "options" in msg and len(msg) < 400, msg
+
+
+def test_invalid_input_error_is_a_value_error():
+    assert issubclass(_native.InvalidInputError, ValueError)
+
+
+def test_every_function_of_the_module_is_covered():
+    functions = {n for n in dir(_native) if callable(getattr(_native, n)) and not isinstance(getattr(_native, n), type)}
+    covered = set(FUNCTIONS) | {"write_vdb", "read_vdb"}
+    assert functions == covered, functions ^ covered
+
+
+@pytest.mark.parametrize("lo, hi, words", [
+    (0.9, 0.1, ["'lo' must not exceed 'hi'"]),
+    (math.nan, 2, ["'lo'", "[0, 1]"]),
+    (0.1, 2, ["'hi'", "[0, 1]"]),
+    (-0.5, 0.5, ["'lo'", "[0, 1]"]),
+    ("0", 1, ["'lo'", "str"]),
+    (0, None, ["'hi'"]),
+])
+def test_set_span_refuses_a_bad_span(lo, hi, words):
+    ctx = _native.ExecContext()
+    with pytest.raises(_native.InvalidInputError) as info:
+        ctx.set_span(lo, hi)
+    for w in words:
+        assert w in str(info.value), str(info.value)
+    ctx.set_span(0.2, 0.7)
+    assert ctx.progress == pytest.approx(0.2)
+
+
+# ---- array arguments: lists are converted by NumPy, anything else is refused by name ----------
+
+ARRAYS = {
+    "voxelize": (lambda **a: _native.voxelize(a.get("vertices", VERTS), a.get("faces", FACES), resolution=8),
+                 ["vertices", "faces"]),
+    "volume_frames": (lambda **a: _native.volume_frames(a.get("sdf", SDF), a.get("origin", [0, 0, 0]), 1.0,
+                                                        a.get("points", PTS), a.get("vectors", DIRS)),
+                      ["sdf", "origin", "points", "vectors"]),
+    "synthesize_analogy": (lambda **a: _native.synthesize_analogy(a.get("a", SDF), a.get("a_prime", SDF), a.get("b", SDF),
+                                                                  a_region=a.get("a_region")),
+                           ["a", "a_prime", "b", "a_region"]),
+    "sample_volume": (lambda **a: _native.sample_volume(a.get("volume", VOL), a.get("origin", [0, 0, 0]), 1.0,
+                                                        a.get("points", PTS)), ["volume", "origin", "points"]),
+    "bake_volume_to_uv": (lambda **a: _native.bake_volume_to_uv(VOL, [0, 0, 0], 1.0, a.get("positions", POS),
+                                                                a.get("uvs", UVS), 8, 8), ["positions", "uvs"]),
+    "isosurface": (lambda **a: _native.isosurface(a.get("volume", SDF), a.get("origin", [0, 0, 0]), 1.0),
+                   ["volume", "origin"]),
+    "gaussian_pyramid": (lambda **a: _native.gaussian_pyramid(a.get("volume", VOL)), ["volume"]),
+    "synthesize_solid": (lambda **a: _native.synthesize_solid(a.get("exemplar", IMG), size=8, levels=1,
+                                                              constraint=a.get("constraint")),
+                         ["exemplar", "constraint"]),
+    "synthesize_image": (lambda **a: _native.synthesize_image(a.get("exemplar", IMG), width=8, height=8, levels=1),
+                         ["exemplar"]),
+    "diffuse_direction_field": (lambda **a: _native.diffuse_direction_field(
+        a.get("vertices", VERTS), a.get("faces", FACES), a.get("given", GIVEN)), ["vertices", "faces", "given"]),
+    "preset_direction_field": (lambda **a: _native.preset_direction_field(
+        a.get("vertices", VERTS), a.get("faces", FACES), axis=a.get("axis", (0, 0, 1))), ["vertices", "faces", "axis"]),
+}
+NOT_ARRAYS = [("a string", "abc"), ("a dict", {"x": 1}), ("a ragged list", [[1.0, 2.0], [3.0]]),
+              ("a list of strings", [["a", "b", "c"]])]
+ARRAY_CASES = [(fn, arg, label, value) for fn, (_, args) in ARRAYS.items() for arg in args
+               for label, value in NOT_ARRAYS]
+
+
+@pytest.mark.parametrize("fn, arg, label, value", ARRAY_CASES,
+                         ids=[f"{c[0]}-{c[1]}-{c[2]}" for c in ARRAY_CASES])
+def test_an_array_argument_that_is_no_array_is_refused_by_name(fn, arg, label, value):
+    run, _ = ARRAYS[fn]
+    with pytest.raises(_native.InvalidInputError) as info:
+        run(**{arg: value})
+    msg = str(info.value)
+    assert f"'{arg}'" in msg, msg
+    assert "incompatible function arguments" not in msg and len(msg) < 400, msg
+
+
+def test_array_arguments_accept_nested_lists():
+    dense = _native.voxelize(VERTS, FACES, resolution=8)
+    listed = _native.voxelize(VERTS.tolist(), FACES.tolist(), resolution=8)
+    np.testing.assert_array_equal(dense["density"], listed["density"])
+    np.testing.assert_array_equal(
+        _native.sample_volume(VOL, [0, 0, 0], 1.0, PTS), _native.sample_volume(VOL.tolist(), (0, 0, 0), 1.0, PTS.tolist()))
+    v1, _ = _native.isosurface(SDF, [0, 0, 0], 1.0)
+    v2, _ = _native.isosurface(SDF.tolist(), [0, 0, 0], 1.0)
+    np.testing.assert_array_equal(v1, v2)
+    assert [a.shape for a in _native.gaussian_pyramid(VOL.tolist(), levels=2)] == [(4, 4, 4), (2, 2, 2)]
+    f1 = _native.diffuse_direction_field(VERTS, FACES, GIVEN)
+    f2 = _native.diffuse_direction_field(VERTS.tolist(), FACES.tolist(), GIVEN.tolist())
+    np.testing.assert_array_equal(f1, f2)
+
+
+def test_integer_like_arguments_accept_numpy_scalars():
+    a = _native.voxelize(VERTS, FACES, resolution=np.int64(8), padding=np.int32(1), seed=np.uint64(2 ** 63),
+                         voxel_size=np.float32(0.0), compute_sdf=np.bool_(True))
+    b = _native.voxelize(VERTS, FACES, resolution=8, padding=1)
+    np.testing.assert_array_equal(a["sdf"], b["sdf"])
+
+
+def test_the_largest_seed_is_accepted():
+    _native.make_exemplar_pair("spikes", resolution=8, jitter=0.1, seed=2 ** 64 - 1)
+
+
+@pytest.mark.parametrize("weight", [2.0, -0.5, math.nan])
+def test_solid_constraint_weight_outside_0_1_is_refused(weight):
+    c = np.zeros((8, 8, 8, 4), np.float32)
+    c[..., 3] = 0.5
+    c[1, 2, 3, 3] = weight
+    with pytest.raises(_native.InvalidInputError) as info:
+        _native.synthesize_solid(IMG, size=8, levels=1, constraint=c)
+    assert "'constraint'" in str(info.value)
+    if not math.isnan(weight):
+        assert "[0, 1]" in str(info.value)
+
+
+# ---- files ------------------------------------------------------------------------------------
+
+def test_vdb_arguments_are_checked(tmp_path):
+    path = tmp_path / "a.vdb"
+    _native.write_vdb(path, {"density": VOL.tolist()}, (0, 0, 0), 1.0)  # pathlib.Path and a list are fine
+    assert set(_native.read_vdb(path, "density")["grids"]) == {"density"}
+    cases = [
+        (lambda: _native.write_vdb(5, {"d": VOL}, [0, 0, 0], 1.0), ["'path'", "file path"]),
+        (lambda: _native.write_vdb(str(path), [VOL], [0, 0, 0], 1.0), ["'grids'", "dict"]),
+        (lambda: _native.write_vdb(str(path), {1: VOL}, [0, 0, 0], 1.0), ["'grids'", "str"]),
+        (lambda: _native.write_vdb(str(path), {"d": VOL}, [0, 0, 0], "1"), ["'voxel_size'", "> 0"]),
+        (lambda: _native.write_vdb(str(path), {"d": VOL}, [0, 0, 0], math.nan), ["'voxel_size'", "finite"]),
+        (lambda: _native.write_vdb(str(path), {"d": VOL}, "abc", 1.0), ["'origin'"]),
+        (lambda: _native.read_vdb(None), ["'path'"]),
+        (lambda: _native.read_vdb(str(path), 5), ["'names'", "list"]),
+        (lambda: _native.read_vdb(str(path), ["density", 3]), ["'names'", "item 1"]),
+        (lambda: _native.read_vdb(str(path), grid="density"), ["unknown option 'grid'", "names"]),
+        (lambda: _native.write_vdb(str(path), {"d": VOL}, [0, 0, 0], 1.0, mode="w"), ["unknown option 'mode'"]),
+    ]
+    for run, words in cases:
+        with pytest.raises(_native.InvalidInputError) as info:
+            run()
+        for w in words:
+            assert w in str(info.value), str(info.value)
