@@ -195,3 +195,80 @@ def test_bake_gives_sub_texel_islands_their_centroid_texel():
     assert (x, y) == (int(round(0.2633 * 8 - 0.5)), int(round(0.2633 * 8 - 0.5)))
     want = _native.sample_volume(vol, [0, 0, 0], 1.0, pos[0].mean(0, keepdims=True))[0]
     np.testing.assert_allclose(img[y, x], want, atol=1e-6)
+
+
+# --- hardening: value range, sizes, exemplar analysis (issue 12) ---------
+
+@pytest.mark.parametrize("search", ["kcoherence", "exact"])
+def test_huge_finite_exemplar_values_work(search):
+    # 1e20 used to overflow the float squared distances: a segfault, or
+    # "final energy nan" reported as success.
+    ex = exemplar(size=32).astype(np.float64) / 255.0 * 1e20
+    res = _native.synthesize_solid(ex, size=16, levels=1, iterations=1, search=search, seed=1)
+    s = res["solid"]
+    assert np.isfinite(s).all() and np.isfinite(res["energy"]).all()
+    assert ex.min() * 0.999 <= s.min() and s.max() <= ex.max() * 1.001
+    img = _native.synthesize_image(ex, width=24, height=24, levels=1, iterations=1, search=search)["image"]
+    assert np.isfinite(img).all() and img.max() <= ex.max() * 1.001
+
+
+def test_one_size_rule_exposed_and_stated():
+    assert _native.min_texture_size(levels=3, neighborhood=8) == 29
+    assert _native.min_texture_size(levels=1) == 8
+    assert _native.SOLID_MAX_SIZE == 2048 and _native.IMAGE_MAX_SIZE == 16384
+    ex = exemplar(size=32)
+    for size in (1, 2, 16, 28):
+        with pytest.raises(_native.InvalidInputError, match="size must be between 29 and 2048 voxels with 3 levels"):
+            _native.synthesize_solid(ex, size=size)
+    with pytest.raises(_native.InvalidInputError, match="width must be between 29 and 16384 pixels"):
+        _native.synthesize_image(ex, width=1, height=1)
+    with pytest.raises(_native.InvalidInputError, match="height must be between 8 and 16384"):
+        _native.synthesize_image(ex, width=8, height=7, levels=1)
+    assert _native.synthesize_solid(ex, size=8, levels=1, iterations=1)["solid"].shape == (8, 8, 8, 3)
+
+
+def test_many_channel_exemplar_runs():
+    # 100 channels x 8 x 8 = 6400-dimensional neighbourhoods: the PCA used to
+    # take minutes (a 6400^2 eigen-decomposition).
+    rng = np.random.default_rng(2)
+    base = exemplar(size=32).astype(np.float32) / 255.0
+    ex = np.concatenate([base] + [base[..., :1] * rng.random(1, dtype=np.float32) for _ in range(97)], -1)
+    assert ex.shape == (32, 32, 100)
+    s = _native.synthesize_solid(ex, size=16, levels=1, iterations=1, seed=1)["solid"]
+    assert s.shape == (16, 16, 16, 100) and np.isfinite(s).all()
+
+
+def test_exemplar_analysis_reports_progress_and_cancels():
+    import threading
+    import time
+    big = np.asarray(Image.open(TEXTURES / "crackedground.png").convert("RGB").resize((512, 512), Image.BICUBIC))
+    ctx = _native.ExecContext()
+    seen, errors = [], []
+
+    def run():
+        try:
+            _native.synthesize_image(big, width=64, height=64, levels=1, ctx=ctx)
+        except Exception as e:  # noqa: BLE001 - checked below
+            errors.append(e)
+
+    t = threading.Thread(target=run)
+    t.start()
+    while t.is_alive() and not any("k-coherence" in s for s, _ in seen):
+        seen.append((ctx.stage, ctx.progress))
+        time.sleep(0.002)
+    ctx.cancel()
+    t.join()
+    stages = {s for s, _ in seen}
+    assert any("exemplar analysis (neighbourhoods, PCA)" in s for s in stages)
+    assert any("exemplar analysis (k-coherence sets)" in s for s in stages)
+    assert len({p for _, p in seen}) > 2, "progress moved during the analysis"
+    assert len(errors) == 1 and isinstance(errors[0], _native.CancelledError)
+
+
+def test_large_exemplar_is_analysed_at_the_working_resolution():
+    big = np.asarray(Image.open(TEXTURES / "crackedground.png").convert("RGB").resize((1100, 1000), Image.BICUBIC))
+    # 1100 -> 550 -> 275 <= max_exemplar_size
+    img = _native.synthesize_image(big, width=40, height=40, levels=1, iterations=1, max_exemplar_size=300)["image"]
+    assert img.shape == (40, 40, 3)
+    with pytest.raises(_native.OverBudgetError, match="1100x1000 3-channel exemplar.*the exemplar is too big"):
+        _native.synthesize_image(big, width=40, height=40, levels=1, max_exemplar_size=0, memory_budget=256 << 20)
