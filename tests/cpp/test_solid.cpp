@@ -155,9 +155,11 @@ TEST(Solid, ToroidalSolidTilesAcrossItsFaces) {
         }
       return s;
     };
+    // (The largest interior step of its kind, plus a margin: one seed of a
+    // chaotic optimisation, on an exemplar of a few discs, varies by axis.)
     double interior = 0;
-    for (int a = 1; a + 1 < N; a += 2) interior += step(a, a + 1) / (N / 2 - 1);
-    EXPECT_LT(step(N - 1, 0), 1.5 * interior) << "axis " << axis;
+    for (int a = 1; a + 1 < N; a += 2) interior = std::max(interior, step(a, a + 1));
+    EXPECT_LT(step(N - 1, 0), 1.25 * interior) << "axis " << axis;
   }
 }
 

@@ -22,8 +22,8 @@
 namespace exsynth {
 
 /// Default working resolution (see TextureOptimizationOptions::max_exemplar_size):
-/// the exemplar analysis takes ~2 s on two cores at 512^2 RGB.
-constexpr int kDefaultMaxExemplarSize = 512;
+/// larger exemplars are analysed at 1/2, 1/4, ... of their size (a 512^2 photo at 256^2).
+constexpr int kDefaultMaxExemplarSize = 256;
 /// Largest output edge: solids (size^3 voxels) and images (pixels).
 constexpr int kMaxSolidSize = 2048;
 constexpr int kMaxImageSize = 16384;
@@ -54,6 +54,10 @@ struct TextureOptimizationOptions {
   double ann_eps = 2.0;          ///< KdTree: nanoflann's eps (approximation tolerance)
   bool histogram_matching = true;
   int histogram_bins = 16;       ///< per channel
+  /// Finer levels start from the coarser level's matches applied to the finer
+  /// exemplar (one optimisation pass before the first search) rather than
+  /// from the trilinearly upsampled texture alone, which keeps the detail.
+  bool coherent_upsampling = true;
   bool mean_shift = false;       ///< mean-shift mode of the contributions instead of the mean (sharper)
   /// > 0: add the feature-distance channel (signed distance to the edges of
   /// the exemplar's dark features) with this weight relative to colours in

@@ -210,6 +210,7 @@ double LevelSolver::search(int iteration, bool exhaustive, StageProgress& progre
 }
 
 void LevelSolver::optimize(int iteration, StageProgress& progress) {
+  const bool collect = opt_.mean_shift;
   const int dims[3] = {tex_.nx(), tex_.ny(), tex_.nz()};
   const int bins = opt_.histogram_bins;
   const bool hist = opt_.histogram_matching;
@@ -336,7 +337,7 @@ void LevelSolver::optimize(int iteration, StageProgress& progress) {
                     const float* e = img.data() + pix * C_;
                     for (int c = 0; c < C_; ++c) acc[c] += wt * e[c];
                     wsum += wt;
-                    if (opt_.mean_shift) {
+                    if (collect) {
                       values.insert(values.end(), e, e + C_);
                       weights.push_back(wt);
                     }

@@ -2,6 +2,7 @@
 // view on a one-voxel-thick volume), and their validation.
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
 #include <memory>
 #include <string>
 
@@ -304,9 +305,18 @@ TextureResult optimize_texture(const Job& job, const TextureOptimizationOptions&
                                                        hash_index(opt.seed, std::uint64_t(l), 0x5EED), lo, hi);
     const bool coarsest = l == 0;
     if (!coarsest) solver->inherit_matches(*previous);
+
     const int iterations = coarsest ? 2 * opt.iterations : opt.iterations;
     StageProgress progress(ctx, stage, p0 + 0.1 * (p1 - p0), p1,
-                           std::size_t(iterations) * (solver->search_units() + solver->optimize_units()));
+                           std::size_t(iterations) * (solver->search_units() + solver->optimize_units()) +
+                               (!coarsest && opt.coherent_upsampling ? solver->optimize_units() : 0));
+    // Coherent upsampling: the finer level's texture is first rebuilt from the
+    // inherited matches, i.e. from the finer exemplar's own texels, instead of
+    // being searched from the trilinearly upsampled (blurred) coarse texture:
+    // a blurred query's nearest windows are the exemplar's smoothest ones, so
+    // the blur would persist. Measured (docs/solid.md): 2D sharpness 0.71 ->
+    // 0.88 (crackedground), 0.36 -> 0.84 (stone33) at no search cost.
+    if (!coarsest && opt.coherent_upsampling) solver->optimize(iterations, progress);
     for (int it = 0; it < iterations; ++it) {
       // The coarsest level has no coherent matches to start from and is
       // small: search it exhaustively (in PCA space) until matches settle.
