@@ -412,7 +412,7 @@ def test_mesh_without_faces(exemplar):
 
 def test_size_too_small_for_the_levels(cow, exemplar):
     settings().solid_levels = 3  # 16 voxels at the coarsest of 3 levels: 4
-    run_expecting_error(r"use fewer levels or a larger size", objects=[cow])
+    run_expecting_error(r"size must be between 29 and 2048 voxels with 3 levels.*fewer levels", objects=[cow])
 
 
 def test_over_the_memory_budget(cow, exemplar):

@@ -5,7 +5,9 @@
 #include <gtest/gtest.h>
 #include <tbb/global_control.h>
 
+#include <Eigen/Eigenvalues>
 #include <cmath>
+#include <utility>
 #include <limits>
 
 #include "exsynth/solid.hpp"
@@ -153,9 +155,11 @@ TEST(Solid, ToroidalSolidTilesAcrossItsFaces) {
         }
       return s;
     };
+    // (The largest interior step of its kind, plus a margin: one seed of a
+    // chaotic optimisation, on an exemplar of a few discs, varies by axis.)
     double interior = 0;
-    for (int a = 1; a + 1 < N; a += 2) interior += step(a, a + 1) / (N / 2 - 1);
-    EXPECT_LT(step(N - 1, 0), 1.5 * interior) << "axis " << axis;
+    for (int a = 1; a + 1 < N; a += 2) interior = std::max(interior, step(a, a + 1));
+    EXPECT_LT(step(N - 1, 0), 1.25 * interior) << "axis " << axis;
   }
 }
 
@@ -258,13 +262,102 @@ TEST(SolidErrors, BadInputsNameTheProblem) {
   EXPECT_THAT(message(constrained, o), HasSubstr("with 4 channels"));
   SolidOptions tiny = o;
   tiny.size = 8;
-  EXPECT_THAT(message(one_exemplar(disc_texture(32, 32, 3, 1)), tiny), HasSubstr("fewer levels or a larger size"));
+  EXPECT_THAT(message(one_exemplar(disc_texture(32, 32, 3, 1)), tiny),
+              HasSubstr("size must be between 15 and 2048 voxels with 2 levels and 8x8 neighbourhoods, got 8; use a "
+                        "larger size or fewer levels"));
   SolidExemplars one_view = one_exemplar(disc_texture(32, 32, 3, 1));
   one_view.active = {false, false, true};
   EXPECT_THAT(message(one_view, o), HasSubstr("two active views"));
   SolidOptions bad = o;
   bad.neighborhood = 2;
   EXPECT_THAT(message(one_exemplar(disc_texture(32, 32, 3, 1)), bad), HasSubstr("neighborhood"));
+}
+
+// One size rule for solids and images: from min_texture_size (the coarsest
+// level holds one neighbourhood) up to the maximum. Size 1 used to slip
+// through (refused from 2 to 16, accepted at 1).
+TEST(SolidErrors, OneSizeRuleForSolidsAndImages) {
+  EXPECT_EQ(min_texture_size(3, 8), 29);
+  EXPECT_EQ(min_texture_size(1, 8), 8);
+  EXPECT_EQ(min_texture_size(2, 5), 9);
+  const SolidExemplars ex = one_exemplar(disc_texture(32, 32, 3, 1));
+  SolidOptions o = small_options();  // 2 levels: from 15
+  for (int size : {1, 2, 14, 2049}) {
+    o.size = size;
+    try {
+      synthesize_solid(ex, o);
+      ADD_FAILURE() << "size " << size << " accepted";
+    } catch (const InvalidInput& e) {
+      EXPECT_THAT(e.what(), HasSubstr("size must be between 15 and 2048 voxels"));
+    }
+  }
+  o.levels = 1;
+  o.size = 8;
+  EXPECT_EQ(synthesize_solid(ex, o).texture.nx(), 8);
+  ImageSynthesisOptions io;
+  io.levels = 2;
+  for (auto wh : {std::pair{1, 1}, std::pair{32, 1}, std::pair{14, 40}}) {
+    io.width = wh.first;
+    io.height = wh.second;
+    try {
+      synthesize_image(ex.views[0], io);
+      ADD_FAILURE() << wh.first << "x" << wh.second << " accepted";
+    } catch (const InvalidInput& e) {
+      EXPECT_THAT(e.what(), HasSubstr("must be between 15 and 16384 pixels"));
+    }
+  }
+  io.width = 15;
+  io.height = 15;
+  EXPECT_EQ(synthesize_image(ex.views[0], io).width(), 15);
+}
+
+// Values around 1e18 and above used to overflow the squared distances in
+// float (segfault with k-coherence and the exact search). Any finite scale
+// works: the result is the exemplar's scale, finite, within its range.
+TEST(Solid, HugeAndTinyExemplarValuesWork) {
+  const Image base = disc_texture(32, 32, 3, 4);
+  for (float scale : {1e20f, 3e36f, 1e-30f}) {
+    Image ex = base;
+    for (float& v : ex.values()) v *= scale;
+    for (SolidSearch search : {SolidSearch::KCoherence, SolidSearch::Exact, SolidSearch::KdTree}) {
+      SolidOptions o = small_options();
+      o.size = 16;
+      o.levels = 1;
+      o.search = search;
+      o.iterations = 1;
+      const TextureResult r = synthesize_solid(one_exemplar(ex), o);
+      const auto [lo, hi] = std::minmax_element(r.texture.values().begin(), r.texture.values().end());
+      EXPECT_GE(*lo, 0.15f * scale * 0.999f) << scale;
+      EXPECT_LE(*hi, 1.0f * scale * 1.001f) << scale;
+      for (double e : r.energy) EXPECT_TRUE(std::isfinite(e)) << scale;
+    }
+    ImageSynthesisOptions io;
+    io.width = io.height = 24;
+    io.levels = 1;
+    const Image img = synthesize_image(ex, io);
+    for (float v : img.values()) ASSERT_TRUE(std::isfinite(v));
+  }
+}
+
+// A 4096^2 exemplar for an 8^3 solid used to be told to "lower the size".
+TEST(SolidErrors, MemoryMessageBlamesTheExemplarWhenItIsTheCause) {
+  SolidOptions o = small_options();
+  o.size = 16;
+  o.levels = 1;
+  o.iterations = 1;
+  o.max_exemplar_size = 0;            // full resolution
+  o.memory_budget = std::size_t(64) << 20;  // the 400^2 exemplar's analysis needs ~200 MiB
+  try {
+    synthesize_solid(one_exemplar(disc_texture(400, 400, 3, 1)), o);
+    FAIL();
+  } catch (const OverBudget& e) {
+    EXPECT_THAT(e.what(), HasSubstr("400x400 3-channel exemplar"));
+    EXPECT_THAT(e.what(), HasSubstr("the exemplar is too big"));
+    EXPECT_THAT(e.what(), HasSubstr("max_exemplar_size"));
+    EXPECT_THAT(e.what(), ::testing::Not(HasSubstr("lower the size")));
+  }
+  o.max_exemplar_size = 100;  // working resolution: 400 -> 200 -> 100, fits
+  EXPECT_EQ(synthesize_solid(one_exemplar(disc_texture(400, 400, 3, 1)), o).texture.nx(), 16);
 }
 
 TEST(SolidErrors, RefusesSizesOverTheMemoryBudget) {
@@ -295,7 +388,72 @@ TEST(Image2D, SynthesisesTheRequestedSizeAndTiles) {
   EXPECT_LT(slice_to_exemplar_distance(as_volume, 2, ex), 0.5 * slice_to_exemplar_distance(shuffled(as_volume), 2, ex));
 }
 
+#include "solid/exemplar_index.hpp"
 #include "solid/feature_channel.hpp"
+
+// The k-coherence sets from the k-d tree (approximate: a tree over half the
+// windows in leading PCA dimensions, re-ranked) against the brute force over
+// all pairs: the same overlap rule, and sets almost as close.
+TEST(ExemplarIndex, KdTreeCoherenceSetsComeCloseToBruteForce) {
+  const Image img = disc_texture(56, 48, 3, 9, 30, 3.0f);
+  const std::vector<float> lo(3, 0.0f), hi(3, 1.0f);
+  using solid::ExemplarIndex;
+  const ExemplarIndex fast(img, 8, 0.95, 32, 4, 16, lo, hi, nullptr, "", 0, 1, ExemplarIndex::Coherence::KdTree);
+  const ExemplarIndex ref(img, 8, 0.95, 32, 4, 16, lo, hi, nullptr, "", 0, 1, ExemplarIndex::Coherence::BruteForce);
+  ASSERT_EQ(fast.count(), ref.count());
+  double fast_sum = 0, ref_sum = 0;
+  int same = 0;
+  auto dist = [&](int j, int i) { return double((ref.coefficients().row(i) - ref.coefficients().row(j)).squaredNorm()); };
+  for (int j = 0; j < ref.count(); ++j)
+    for (int q = 0; q < 4; ++q) {
+      const int a = fast.similar(j)[q], b = ref.similar(j)[q];
+      ASSERT_GE(a, 0);
+      ASSERT_GE(b, 0);
+      const int half = 4;
+      EXPECT_FALSE(std::abs(fast.centre_u(a) - fast.centre_u(j)) < half && std::abs(fast.centre_v(a) - fast.centre_v(j)) < half);
+      fast_sum += dist(j, a);
+      ref_sum += dist(j, b);
+      for (int q2 = 0; q2 < 4; ++q2) same += a == ref.similar(j)[q2];
+    }
+  EXPECT_LE(fast_sum, 1.25 * ref_sum);
+  EXPECT_GE(fast_sum, ref_sum * (1 - 1e-4));  // the brute force is the optimum
+  EXPECT_GT(same, ref.count() * 4 / 2);       // most sets agree
+}
+
+// Analysis stages report progress and can be cancelled mid-way (the brute
+// force took minutes on photo-sized exemplars without a check).
+TEST(ExemplarIndex, AnalysisReportsProgressAndCancels) {
+  const Image img = disc_texture(64, 64, 3, 2);
+  ExecContext ctx;
+  const std::vector<float> lo(3, 0.0f), hi(3, 1.0f);
+  solid::ExemplarIndex idx(img, 8, 0.95, 32, 4, 16, lo, hi, &ctx, "analysis", 0.2, 0.6);
+  EXPECT_NEAR(ctx.progress(), 0.6, 1e-9);
+  EXPECT_THAT(ctx.stage(), HasSubstr("analysis (k-coherence sets)"));
+  ctx.cancel();
+  EXPECT_THROW(solid::ExemplarIndex(img, 8, 0.95, 32, 4, 16, lo, hi, &ctx, "analysis", 0, 1), Cancelled);
+}
+
+// Many channels: the PCA of 100 x 8 x 8 = 6400-dimensional neighbourhoods
+// (randomized subspace iteration) used to take minutes (an O(D^3) eigen-
+// decomposition); its leading component matches the exact one.
+TEST(Pca, WideSamplesUseTheLeadingSubspace) {
+  const int rows = 300, D = 700;
+  search::RowMatrixXf x(rows, D);
+  for (int r = 0; r < rows; ++r)
+    for (int c = 0; c < D; ++c) {
+      IndexRng g(3, std::uint64_t(r), std::uint64_t(c));
+      x(r, c) = float(std::sin(0.01 * c * (1 + r % 5)) * (1 + r % 3) + 0.05 * g.uniform());
+    }
+  const search::Pca fast = search::fit_pca(x, 0.95, 8);
+  search::RowMatrixXf narrow = x.leftCols(500);  // <= 512: the exact path, as a sanity check of the test data
+  EXPECT_GE(search::fit_pca(narrow, 0.95, 8).dims(), 1);
+  // Exact reference for the wide data: the covariance's eigenvectors.
+  const Eigen::MatrixXd c = x.cast<double>().rowwise() - x.cast<double>().colwise().mean();
+  Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(c.transpose() * c);
+  const Eigen::VectorXd top = eig.eigenvectors().col(D - 1);
+  EXPECT_GT(std::abs(top.dot(fast.basis.col(0).cast<double>())), 0.999);
+  EXPECT_GT(fast.kept_variance, 0.5);
+}
 
 TEST(FeatureChannel, SignedDistanceToTheDarkFeaturesEdge) {
   // A dark 10x10 square (the feature) on a light 40x40 image.

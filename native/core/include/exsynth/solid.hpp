@@ -21,6 +21,19 @@
 
 namespace exsynth {
 
+/// Default working resolution (see TextureOptimizationOptions::max_exemplar_size):
+/// larger exemplars are analysed at 1/2, 1/4, ... of their size (a 512^2 photo at 256^2).
+constexpr int kDefaultMaxExemplarSize = 256;
+/// Largest output edge: solids (size^3 voxels) and images (pixels).
+constexpr int kMaxSolidSize = 2048;
+constexpr int kMaxImageSize = 16384;
+
+/// Smallest output edge (voxels or pixels) the optimiser accepts with these
+/// levels and neighbourhood: the coarsest level, each level halving the
+/// edge (rounding up), must still hold one n x n neighbourhood. The one rule
+/// for solids (size) and images (width and height): 29 for the defaults.
+int min_texture_size(int levels, int neighborhood);
+
 /// How the search phase finds an exemplar neighbourhood for a voxel.
 enum class SolidSearch {
   KCoherence,  ///< default: candidates from neighbours' matches + their k most similar neighbourhoods
@@ -41,12 +54,21 @@ struct TextureOptimizationOptions {
   double ann_eps = 2.0;          ///< KdTree: nanoflann's eps (approximation tolerance)
   bool histogram_matching = true;
   int histogram_bins = 16;       ///< per channel
+  /// Finer levels start from the coarser level's matches applied to the finer
+  /// exemplar (one optimisation pass before the first search) rather than
+  /// from the trilinearly upsampled texture alone, which keeps the detail.
+  bool coherent_upsampling = true;
   bool mean_shift = false;       ///< mean-shift mode of the contributions instead of the mean (sharper)
   /// > 0: add the feature-distance channel (signed distance to the edges of
   /// the exemplar's dark features) with this weight relative to colours in
   /// [0, 1]; it guides matching and is dropped from the output. 0 = off.
   double feature_weight = 0.0;
   bool tileable = true;          ///< toroidal boundaries, so the output tiles
+  /// Working resolution: an exemplar whose longer edge exceeds this many
+  /// pixels is analysed at half, quarter, ... resolution (Gaussian pyramid
+  /// steps) until it fits, so its features come out that much smaller in
+  /// the output. 0 = always full resolution (memory and time grow with it).
+  int max_exemplar_size = kDefaultMaxExemplarSize;
   std::size_t memory_budget = kDefaultMemoryBudget;
   std::uint64_t seed = 0;
 };

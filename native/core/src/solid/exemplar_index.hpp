@@ -4,6 +4,8 @@
 // inside the image: exemplars are not assumed to tile), their PCA
 // coefficients, k-coherence sets, and channel histograms.
 #include <cstdint>
+#include <cstdlib>
+#include <string>
 #include <vector>
 
 #include "exsynth/exec_context.hpp"
@@ -16,10 +18,17 @@ using search::RowMatrixXf;
 
 class ExemplarIndex {
  public:
+  /// How the k-coherence sets are found: nanoflann k-NN in PCA space (the
+  /// default: ~N log N), or the brute-force reference (all pairs, N^2; the
+  /// tests compare the two).
+  enum class Coherence { KdTree, BruteForce };
+
   /// Builds everything; `coherence_k` = 0 skips the k-coherence sets.
+  /// Progress goes to [lo, hi] of `ctx` under the stage name `stage`, and
+  /// each part checks for cancellation at chunk granularity.
   ExemplarIndex(const Image& image, int n, double pca_variance, int max_pca_dims, int coherence_k, int bins,
-                const std::vector<float>& channel_lo, const std::vector<float>& channel_hi,
-                StageProgress* progress);
+                const std::vector<float>& channel_lo, const std::vector<float>& channel_hi, ExecContext* ctx,
+                const std::string& stage, double lo, double hi, Coherence coherence = Coherence::KdTree);
 
   const Image& image() const { return image_; }
   int n() const { return n_; }
@@ -53,8 +62,15 @@ class ExemplarIndex {
   double histogram(int c, int b) const { return hist_[std::size_t(c) * bins_ + b]; }
 
  private:
-  void build_neighbourhoods();
-  void build_coherence(int k, StageProgress* progress);
+  void build_neighbourhoods(StageProgress& progress);
+  void project(StageProgress& progress);
+  void build_coherence_kdtree(StageProgress& progress);
+  void build_coherence_brute_force(StageProgress& progress);
+  /// Windows i and j overlap by more than half along both axes (near-copies).
+  bool overlaps(int i, int j) const {
+    const int half = n_ / 2;
+    return std::abs(centre_u(i) - centre_u(j)) < half && std::abs(centre_v(i) - centre_v(j)) < half;
+  }
 
   Image image_;
   int n_, vw_, vh_, k_ = 0, bins_;

@@ -5,8 +5,6 @@
 #include <limits>
 #include <numeric>
 
-#include <nanoflann.hpp>
-
 #include "exsynth/parallel.hpp"
 #include "exsynth/rng.hpp"
 
@@ -14,26 +12,6 @@ namespace exsynth::solid {
 
 constexpr std::size_t kBatch = 256;  // sparse voxels gathered and PCA-projected together (one GEMM)
 constexpr int kBlock = 8;            // optimisation visits blocks of kBlock^3 voxels in random order
-
-// The paper-faithful search: approximate nearest neighbour in PCA space.
-class KdSearch {
- public:
-  using Tree = nanoflann::KDTreeEigenMatrixAdaptor<RowMatrixXf, -1, nanoflann::metric_L2_Simple>;
-  explicit KdSearch(const RowMatrixXf& coeffs) : tree_(int(coeffs.cols()), std::cref(coeffs), 16) {
-    tree_.index->buildIndex();
-  }
-  int nearest(const float* q, float eps) const {
-    Eigen::Index idx = 0;
-    float d2 = 0;
-    nanoflann::KNNResultSet<float, Eigen::Index> result(1);
-    result.init(&idx, &d2);
-    tree_.index->findNeighbors(result, q, nanoflann::SearchParams(32, eps));
-    return int(idx);
-  }
-
- private:
-  Tree tree_;
-};
 
 LevelSolver::LevelSolver(Volume& texture, std::array<const ExemplarIndex*, 3> views, const Volume& constraint,
                          const TextureOptimizationOptions& opt, bool wrap, std::uint64_t seed,
@@ -58,7 +36,7 @@ LevelSolver::LevelSolver(Volume& texture, std::array<const ExemplarIndex*, 3> vi
     w.nv = (dims[s.v] + 1) / 2;
     w.match.assign(w.size(), -1);
     w.weight.assign(w.size(), 1.0f);
-    if (opt_.search == SolidSearch::KdTree) w.kd = std::make_unique<KdSearch>(w.ex->coefficients());
+    if (opt_.search == SolidSearch::KdTree) w.kd = std::make_unique<search::KdTree>(w.ex->coefficients());
   }
 }
 
@@ -158,10 +136,10 @@ double LevelSolver::search(int iteration, bool exhaustive, StageProgress& progre
             float bd = std::numeric_limits<float>::max();
             for (int j = 0; j < ex.count(); ++j) {
               const float d = (ex.neighbourhoods().row(j) - x.row(Eigen::Index(k))).squaredNorm();
-              if (d < bd) bd = d, best = j;
+              if (d < bd || best < 0) bd = d, best = j;
             }
           } else if (opt_.search == SolidSearch::KdTree) {
-            best = w.kd->nearest(y.row(Eigen::Index(k)).data(), float(opt_.ann_eps));
+            best = int(w.kd->nearest(y.row(Eigen::Index(k)).data(), float(opt_.ann_eps)));
           } else if (exhaustive) {
             ((ex.coefficients().rowwise() - y.row(Eigen::Index(k))).rowwise().squaredNorm()).minCoeff(&best);
           } else {
@@ -214,6 +192,7 @@ double LevelSolver::search(int iteration, bool exhaustive, StageProgress& progre
                 acc += (Eigen::Map<const Block>(e + t) - Eigen::Map<const Block>(q + t)).squaredNorm();
               if (t >= d && acc < bd) bd = acc, best = c;
             }
+            if (best < 0) best = cand.front();  // every distance non-finite: never index with -1
           }
           next[sp] = best;
           const float d2 = (ex.neighbourhoods().row(best) - x.row(Eigen::Index(k))).squaredNorm();
@@ -231,6 +210,7 @@ double LevelSolver::search(int iteration, bool exhaustive, StageProgress& progre
 }
 
 void LevelSolver::optimize(int iteration, StageProgress& progress) {
+  const bool collect = opt_.mean_shift;
   const int dims[3] = {tex_.nx(), tex_.ny(), tex_.nz()};
   const int bins = opt_.histogram_bins;
   const bool hist = opt_.histogram_matching;
@@ -357,7 +337,7 @@ void LevelSolver::optimize(int iteration, StageProgress& progress) {
                     const float* e = img.data() + pix * C_;
                     for (int c = 0; c < C_; ++c) acc[c] += wt * e[c];
                     wsum += wt;
-                    if (opt_.mean_shift) {
+                    if (collect) {
                       values.insert(values.end(), e, e + C_);
                       weights.push_back(wt);
                     }

@@ -9,6 +9,7 @@
 #include "exsynth/exec_context.hpp"
 #include "exsynth/grid.hpp"
 #include "exsynth/solid.hpp"
+#include "search/kd_tree.hpp"
 #include "solid/exemplar_index.hpp"
 
 namespace exsynth::solid {
@@ -19,7 +20,6 @@ struct SliceAxes {
 };
 constexpr SliceAxes kSlices[3] = {{0, 1, 2}, {1, 0, 2}, {2, 0, 1}};
 
-class KdSearch;  // PCA-space k-d tree (defined in the .cpp)
 
 class LevelSolver {
  public:
@@ -50,7 +50,7 @@ class LevelSolver {
     int nu = 0, nv = 0, na = 0;          // sparse grid: na slices x nv rows x nu columns
     std::vector<std::int32_t> match;     // exemplar neighbourhood index per sparse voxel
     std::vector<float> weight;           // IRLS weight |s - e|^(r - 2)
-    std::unique_ptr<KdSearch> kd;
+    std::unique_ptr<search::KdTree> kd;  // search = KdTree only
     std::size_t size() const { return std::size_t(na) * nv * nu; }
   };
 

@@ -1,0 +1,176 @@
+"""Quality numbers for exemplar-based texture synthesis (numpy only, no bpy).
+
+Used by the quality benchmark (bench/bench_quality.py) and the Python-tier
+floors. Values are in 0..255 grey-level units (float inputs with max <= 1
+are scaled by 255), RGB throughout (grey images get three equal channels).
+For a volume (Z, Y, X[, C]) every slice orientation (x, y, z; up to
+`slices` evenly spaced slices each) is compared with the exemplar and the
+numbers are averaged per axis, then over the axes.
+
+  nn_rms     mean over the output's k x k patches (stride `stride`) of the RMS
+             per-pixel-channel L2 distance to the nearest exemplar patch (every
+             exemplar position). Search: PCA to `dims` dimensions, the
+             `candidates` nearest there, re-ranked exactly.
+  nn_rel     nn_rms / the exemplar's RMS contrast (sqrt of the mean
+             per-channel variance): comparable across exemplars; ~1 or more
+             means no better than unstructured.
+  hist_emd   per-channel 1-D earth mover's distance between 32-bin histograms
+             over 0..256, in grey levels, channel mean.
+  sharpness  mean gradient magnitude (central differences, channel mean) of the
+             output / the exemplar's: 1 = as crisp; a blur scores below 1.
+  contrast   output RMS contrast / exemplar RMS contrast.
+  copy_rate  fraction of output patches that match an exemplar patch (RMS <
+             `copy_eps`) and belong to a 4-connected group of >= `min_cells`
+             such patches with the same exemplar offset: verbatim copies.
+  max_copy_frac  pixel area of the largest such copied region / exemplar area.
+"""
+import numpy as np
+
+__all__ = ["load", "image_metrics", "volume_metrics", "Exemplar"]
+
+
+def as_255(a):
+    a = np.asarray(a)
+    scale = 255.0 if a.dtype.kind == "f" and a.size and a.max() <= 1.0 else 1.0
+    return a.astype(np.float64) * scale
+
+
+def rgb(img):
+    img = np.asarray(img, np.float64)
+    if img.ndim == 2:
+        img = img[..., None]
+    if img.shape[-1] == 1:
+        img = np.repeat(img, 3, -1)
+    elif img.shape[-1] != 3:
+        img = np.repeat(img.mean(-1, keepdims=True), 3, -1)
+    return img
+
+
+def load(path):
+    """An image file or a .npy array, in 0..255."""
+    if str(path).endswith(".npy"):
+        return as_255(np.load(path))
+    from PIL import Image
+    return as_255(np.asarray(Image.open(path).convert("RGB")))
+
+
+def patches(img, k, stride):
+    v = np.lib.stride_tricks.sliding_window_view(img, (k, k), axis=(0, 1))[::stride, ::stride]
+    gh, gw = v.shape[:2]
+    return v.reshape(gh * gw, -1), gh, gw
+
+
+class Exemplar:
+    """An exemplar's patches and their PCA, built once for many outputs."""
+
+    def __init__(self, img, k=8, dims=24):
+        self.img = rgb(as_255(img))
+        self.k = k
+        self.P, self.gh, self.gw = patches(self.img, k, 1)
+        self.mean = self.P.mean(0)
+        X = self.P - self.mean
+        _, V = np.linalg.eigh(X.T @ X)
+        self.basis = V[:, ::-1][:, :min(dims, V.shape[1])]
+        self.Y = X @ self.basis
+        self.Yn = (self.Y ** 2).sum(1)
+        self.contrast = float(np.sqrt(self.img.reshape(-1, 3).var(0).mean()))
+        self.grad = grad_energy(self.img)
+
+    def nearest(self, Q, candidates=8, chunk=2048):
+        """(squared distance, index) of each row of Q's nearest exemplar patch."""
+        d2 = np.empty(len(Q))
+        idx = np.empty(len(Q), np.int64)
+        c = min(candidates, len(self.P))
+        for s in range(0, len(Q), chunk):
+            q = Q[s:s + chunk]
+            y = (q - self.mean) @ self.basis
+            approx = (y ** 2).sum(1)[:, None] + self.Yn[None, :] - 2.0 * y @ self.Y.T
+            cand = np.argpartition(approx, c - 1, axis=1)[:, :c]
+            exact = ((self.P[cand] - q[:, None, :]) ** 2).sum(-1)
+            j = exact.argmin(1)
+            d2[s:s + chunk] = exact[np.arange(len(q)), j]
+            idx[s:s + chunk] = cand[np.arange(len(q)), j]
+        return d2, idx
+
+
+def grad_energy(img):
+    gy = 0.5 * (img[2:, 1:-1] - img[:-2, 1:-1])
+    gx = 0.5 * (img[1:-1, 2:] - img[1:-1, :-2])
+    return float(np.sqrt(gx ** 2 + gy ** 2).mean())
+
+
+def hist_emd(ex, out, bins=32):
+    emd = []
+    for c in range(ex.shape[-1]):
+        p = np.histogram(ex[..., c], bins, (0, 256))[0].astype(float)
+        q = np.histogram(out[..., c], bins, (0, 256))[0].astype(float)
+        p /= p.sum()
+        q /= q.sum()
+        emd.append(np.abs(np.cumsum(p - q)).sum() * 256.0 / bins)
+    return float(np.mean(emd))
+
+
+def label4(mask):
+    """4-connected component labels of a boolean grid (0 = background)."""
+    lab = np.zeros(mask.shape, np.int64)
+    n = 0
+    h, w = mask.shape
+    for i, j in zip(*np.nonzero(mask)):
+        if lab[i, j]:
+            continue
+        n += 1
+        stack = [(i, j)]
+        lab[i, j] = n
+        while stack:
+            a, b = stack.pop()
+            for u, v in ((a + 1, b), (a - 1, b), (a, b + 1), (a, b - 1)):
+                if 0 <= u < h and 0 <= v < w and mask[u, v] and not lab[u, v]:
+                    lab[u, v] = n
+                    stack.append((u, v))
+    return lab, n
+
+
+def image_metrics(E, out, stride=2, copy_eps=1.0, min_cells=16):
+    """The numbers above for one 2D output against Exemplar E."""
+    out = rgb(as_255(out))
+    k = E.k
+    Q, gh, gw = patches(out, k, stride)
+    d2, idx = E.nearest(Q)
+    rms = np.sqrt(d2 / Q.shape[1]).reshape(gh, gw)
+    sy, sx = np.divmod(idx.reshape(gh, gw), E.gw)
+    oy, ox = np.mgrid[0:gh, 0:gw] * stride
+    offset = (sy - oy) * 100003 + (sx - ox)
+    exact = rms < copy_eps
+    copied = np.zeros_like(exact)
+    best = 0
+    for t in np.unique(offset[exact]):
+        lab, n = label4(exact & (offset == t))
+        sizes = np.bincount(lab.ravel())[1:]
+        for c in np.nonzero(sizes >= min_cells)[0] + 1:
+            cells = lab == c
+            copied |= cells
+            foot = np.zeros(out.shape[:2], bool)
+            for i, j in np.argwhere(cells):
+                foot[i * stride:i * stride + k, j * stride:j * stride + k] = True
+            best = max(best, int(foot.sum()))
+    out_contrast = float(np.sqrt(out.reshape(-1, 3).var(0).mean()))
+    return dict(nn_rms=float(rms.mean()), nn_rel=float(rms.mean() / max(E.contrast, 1e-9)),
+                hist_emd=hist_emd(E.img, out), sharpness=grad_energy(out) / max(E.grad, 1e-9),
+                contrast=out_contrast / max(E.contrast, 1e-9), copy_rate=float(copied.mean()),
+                max_copy_frac=best / float(E.img.shape[0] * E.img.shape[1]))
+
+
+def volume_metrics(E, vol, slices=16, **kw):
+    """Per axis ('x', 'y', 'z') and 'mean' of image_metrics over slices of a (Z, Y, X[, C]) volume."""
+    vol = np.asarray(vol)
+    if vol.ndim == 3:
+        vol = vol[..., None]
+    res = {}
+    for name, ax in (("x", 2), ("y", 1), ("z", 0)):
+        ids = np.unique(np.linspace(0, vol.shape[ax] - 1, min(slices, vol.shape[ax])).astype(int))
+        ms = [image_metrics(E, np.take(vol, i, axis=ax), **kw) for i in ids]
+        res[name] = {key: float(np.mean([m[key] for m in ms])) for key in ms[0]}
+        res[name]["max_copy_frac"] = max(m["max_copy_frac"] for m in ms)
+    res["mean"] = {key: float(np.mean([res[n][key] for n in "xyz"])) for key in res["x"]}
+    res["mean"]["max_copy_frac"] = max(res[n]["max_copy_frac"] for n in "xyz")
+    return res

@@ -1,0 +1,154 @@
+#!/usr/bin/env python3
+"""Quality benchmark of solid and 2D synthesis on real exemplars, with peers.
+
+For each exemplar (128^2, resampled with Lanczos from the source listed
+below): a 64^3 solid (and with --full a 128^3 one), a 256^2 image, and the
+peer G'MIC `syntexturize_matchpatch 256,256` on the same exemplar, all with
+default options and seed 7. The numbers are exsynth.quality's (see its
+docstring: nn_rel, sharpness, contrast, hist_emd, copy_rate, max_copy_frac);
+solids are the mean over x, y and z slices. Then speed: whole-process time
+for 128^2 -> 256^2 (the Python module vs the gmic command, alternating in
+the same run, median of 3) and a 128^3 RGB solid.
+
+Exemplar sources: assets/textures (bundled), the Debian packages gimp-data
+(/usr/share/gimp/2.0/patterns) and assimp-testmodels (/usr/share/assimp).
+
+usage: bench_quality.py --build BUILD_DIR [--full] [--exemplars a,b] [--no-peers]
+"""
+import argparse
+import os
+import shutil
+import struct
+import subprocess
+import sys
+import tempfile
+import time
+
+import numpy as np
+from PIL import Image
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+TEX = os.path.join(ROOT, "assets", "textures")
+GIMP = "/usr/share/gimp/2.0/patterns"
+ASSIMP = "/usr/share/assimp/models"
+EXEMPLARS = {  # name: source
+    "crackedground": os.path.join(TEX, "crackedground.png"),
+    "drkwood2": os.path.join(TEX, "drkwood2.png"),
+    "marble1": os.path.join(TEX, "marble1.png"),
+    "granite1": os.path.join(TEX, "granite1.png"),
+    "stone33": os.path.join(GIMP, "Stone", "stone33.pat"),
+    "brick": os.path.join(GIMP, "Stone", "brick.pat"),
+    "slate": os.path.join(GIMP, "Stone", "slate.pat"),
+    "brownground": os.path.join(ASSIMP, "IRRMesh", "brownground_1-1.jpg"),
+}
+KEYS = ("nn_rel", "sharpness", "contrast", "hist_emd", "copy_rate", "max_copy_frac")
+
+
+def read_pat(path):
+    """A GIMP .pat pattern (header, then raw 8-bit pixels) as (H, W, 3) uint8."""
+    data = open(path, "rb").read()
+    header, _, w, h, bpp = struct.unpack(">5I", data[:20])
+    a = np.frombuffer(data[header:header + w * h * bpp], np.uint8).reshape(h, w, bpp)
+    return np.ascontiguousarray(np.repeat(a[..., :1], 3, -1) if bpp < 3 else a[..., :3])
+
+
+def exemplar(name, size=128):
+    path = EXEMPLARS[name]
+    img = Image.fromarray(read_pat(path)) if path.endswith(".pat") else Image.open(path).convert("RGB")
+    return np.asarray(img.resize((size, size), Image.LANCZOS))
+
+
+def gmic_image(ex_png, out_png):
+    subprocess.run(["gmic", "-v", "-1", ex_png, "syntexturize_matchpatch", "256,256", "-o", out_png],
+                   check=True, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    return np.asarray(Image.open(out_png).convert("RGB"))
+
+
+EXSYNTH_CHILD = ("import sys, numpy as np; from PIL import Image; from exsynth import _native; "
+                 "ex = np.asarray(Image.open(sys.argv[1]).convert('RGB')); "
+                 "img = _native.synthesize_image(ex, width=256, height=256, seed=7)['image']; "
+                 "Image.fromarray((np.clip(img, 0, 1) * 255 + 0.5).astype(np.uint8)).save(sys.argv[2])")
+
+
+def whole_process(cmd, env=None):
+    t = time.perf_counter()
+    subprocess.run(cmd, check=True, env=env, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    return time.perf_counter() - t
+
+
+def row(label, m):
+    return f"{label:<44} " + " ".join(f"{m[k]:>9.2f}" for k in KEYS)
+
+
+def main(argv=None):
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--build", required=True)
+    ap.add_argument("--full", action="store_true", help="also 128^3 solids (slower)")
+    ap.add_argument("--exemplars", default=",".join(EXEMPLARS))
+    ap.add_argument("--no-peers", action="store_true")
+    ap.add_argument("--options", default="", help="extra engine options, e.g. 'coherent_upsampling=False'")
+    args = ap.parse_args(argv)
+    sys.path.insert(0, os.path.join(args.build, "addon"))
+    from exsynth import _native, quality
+
+    opts = eval(f"dict({args.options})", {})  # noqa: S307 - a developer's command line
+    peers = not args.no_peers and shutil.which("gmic") is not None
+    names = args.exemplars.split(",")
+    tmp = tempfile.mkdtemp(prefix="exsynth_bench_")
+    print(f"machine: {os.cpu_count()} cores; 128^2 exemplars, {args.options or 'default options'}, seed 7; "
+          "solids: mean of x/y/z slices")
+    header = f"{'output':<44} " + " ".join(f"{k:>9}" for k in KEYS)
+    print(header)
+    print("-" * len(header))
+    totals = {}
+    for name in names:
+        ex = exemplar(name)
+        ex_png = os.path.join(tmp, name + ".png")
+        Image.fromarray(ex).save(ex_png)
+        E = quality.Exemplar(ex)
+        cases = [("solid 64^3", lambda: quality.volume_metrics(
+            E, _native.synthesize_solid(ex, size=64, seed=7, **opts)["solid"], slices=8)["mean"])]
+        if args.full:
+            cases.append(("solid 128^3", lambda: quality.volume_metrics(
+                E, _native.synthesize_solid(ex, size=128, seed=7, **opts)["solid"], slices=4)["mean"]))
+        cases.append(("image 256^2", lambda: quality.image_metrics(
+            E, _native.synthesize_image(ex, width=256, height=256, seed=7, **opts)["image"])))
+        if peers:
+            cases.append(("G'MIC matchpatch 256^2 (peer)", lambda: quality.image_metrics(
+                E, gmic_image(ex_png, os.path.join(tmp, name + "_gmic.png")))))
+        for label, run in cases:
+            m = run()
+            totals.setdefault(label, []).append(m)
+            print(row(f"{name}: {label}", m), flush=True)
+    print("-" * len(header))
+    for label, ms in totals.items():
+        print(row(f"mean over {len(ms)} exemplars: {label}", {k: float(np.mean([m[k] for m in ms])) for k in KEYS}))
+        print(row(f"worst of {len(ms)} exemplars: {label}",
+                  {k: (max if k in ("nn_rel", "hist_emd", "copy_rate", "max_copy_frac") else min)(m[k] for m in ms)
+                   for k in KEYS}))
+
+    print()
+    print("speed (whole process, same run, alternating; median of 3)")
+    env = dict(os.environ, PYTHONPATH=os.path.join(args.build, "addon"))
+    ex_png = os.path.join(tmp, "crackedground.png")
+    Image.fromarray(exemplar("crackedground")).save(ex_png)
+    ours, theirs = [], []
+    for _ in range(3):
+        ours.append(whole_process(["/usr/bin/python3", "-c", EXSYNTH_CHILD, ex_png, os.path.join(tmp, "o.png")], env))
+        if peers:
+            theirs.append(whole_process(["gmic", "-v", "-1", ex_png, "syntexturize_matchpatch", "256,256",
+                                         "-o", os.path.join(tmp, "g.png")]))
+    print(f"  image 128^2 -> 256^2, exsynth (python module)   {np.median(ours):6.2f} s")
+    if peers:
+        print(f"  image 128^2 -> 256^2, gmic syntexturize_matchpatch {np.median(theirs):6.2f} s"
+              f"   (exsynth / gmic = {np.median(ours) / np.median(theirs):.2f})")
+    ex = exemplar("crackedground")
+    t = time.perf_counter()
+    _native.synthesize_solid(ex, size=128, seed=7)
+    print(f"  solid 128^3 RGB (in process)                    {time.perf_counter() - t:6.2f} s")
+    shutil.rmtree(tmp, ignore_errors=True)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
