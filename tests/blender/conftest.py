@@ -18,8 +18,9 @@ def clean_scene():
 
     read_homefile(use_empty=True) keeps registered add-ons (unlike
     read_factory_settings) and resets the scene's ExSynth settings. The
-    unsaved file's cache folder (in Blender's session temp dir) is emptied
-    so file names do not depend on the tests run before.
+    unsaved file's cache folder (in Blender's session temp dir) is emptied;
+    cache file names still count up over the session, as for a user (Blender
+    4.5 keeps a deleted file's grids in memory by path).
     """
     bpy.ops.wm.read_homefile(use_empty=True)
     shutil.rmtree(volume_io.cache_dir(), ignore_errors=True)

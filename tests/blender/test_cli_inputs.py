@@ -49,7 +49,7 @@ def test_a_nan_vertex_is_named(tmp_path, capsys):
     code, err = run(capsys, "analogy", "--b", str(tmp_path / "nan.obj"), "--preset", "spikes", "--resolution", "24",
                     "--out", str(tmp_path / "x.obj"))
     assert code == 2
-    assert "vertex 0 of --b nan.obj is not finite (nan)" in err
+    assert "nan.obj line 2: vertex 0 is not three finite numbers" in err
     assert os.listdir(tmp_path) == ["nan.obj"]
 
 

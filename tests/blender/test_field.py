@@ -200,9 +200,11 @@ def test_existing_field_of_another_kind(bunny):
 def test_curve_missing_or_not_a_curve(bunny):
     settings().field_preset = 'ALONG_CURVE'
     run_expecting_error(r"needs a curve\. Pick a curve object", bunny)
-    # The panel's picker only offers curves, but a script can set anything.
+    # The panel's picker only offers curves, but a script can set anything
+    # (attribute assignment: Blender 4.5 refuses an Object through
+    # scene.exsynth["field_curve"] once the property exists).
     cam = add_camera()
-    bpy.context.scene.exsynth["field_curve"] = cam
+    bpy.context.scene.exsynth.field_curve = cam
     run_expecting_error(r"'Cam' is a camera, not a curve", bunny)
 
 

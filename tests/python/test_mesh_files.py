@@ -15,6 +15,8 @@ TRIANGLE = "v 0 0 0\nv 1 0 0\nv 0 1 0\n"
     (TRIANGLE + "f -1 -2 -4\n", "4: face vertex -4 is out of range"),
     ("v 0 0 0\nf 1 2 3\nv 1 0 0\nv 0 1 0\n", r"2: face vertex 2"),  # used before it is defined
     (TRIANGLE + "f 1 2 x\n", "4: 'x' is not a vertex index"),
+    ("v 0 0 0\nv nan 0 0\nv 0 1 0\nf 1 2 3\n", "2: vertex 1 is not three finite numbers"),
+    ("v 0 0 0\nv 1 0\nv 0 1 0\nf 1 2 3\n", "2: vertex 1 is not three finite numbers"),
 ])
 def test_obj_bad_faces_are_named(tmp_path, text, message):
     path = tmp_path / "m.obj"

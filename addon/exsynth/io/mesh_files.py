@@ -14,6 +14,8 @@ drops vertices that no face uses.
 No bpy here.
 """
 
+import math
+
 import numpy as np
 
 
@@ -22,7 +24,8 @@ class MeshFileError(ValueError):
 
 
 def check_indices(option, path):
-    """Raise MeshFileError if a face of the OBJ or ASCII PLY file names a vertex it does not have."""
+    """Raise MeshFileError if a face of the OBJ or ASCII PLY file names a vertex
+    it does not have, or (OBJ) a vertex is not three finite numbers."""
     lower = path.lower()
     if lower.endswith(".obj"):
         _check_obj(option, path)
@@ -36,6 +39,14 @@ def _check_obj(option, path):
         for number, line in enumerate(f, 1):
             if line.startswith(b"v "):
                 vertices += 1
+                coordinates = line.split()[1:4]
+                try:
+                    finite = len(coordinates) == 3 and all(math.isfinite(float(t)) for t in coordinates)
+                except ValueError:
+                    finite = False
+                if not finite:  # Blender 4.5's importer reads "nan" as 0 and carries on
+                    raise MeshFileError(f"{option}: {path} line {number}: vertex {vertices - 1} is not three finite "
+                                        "numbers; remove or fix it")
             elif line.startswith((b"f ", b"l ")):
                 for token in line.split()[1:]:
                     field = token.split(b"/")[0]

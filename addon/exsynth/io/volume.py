@@ -24,16 +24,24 @@ def cache_dir():
     return os.path.join(bpy.app.tempdir, CACHE_FOLDER)
 
 
+# Every cache path handed out in this session: Blender (seen in 4.5) keeps
+# a file's grids in memory by path, so a new file at a path used before, even
+# one since deleted, would show the old grids.
+_issued = set()
+
+
 def new_cache_path(stem, ext=".vdb"):
-    """A path in the cache folder no existing file uses: an earlier result's
-    file must not be overwritten while its Volume (or an undo step) uses it."""
+    """A path in the cache folder no existing file uses and no earlier result
+    of this session used: an earlier result's file must not be overwritten
+    while its Volume (or an undo step) uses it."""
     stem = bpy.path.clean_name(stem)
     folder = cache_dir()
     path = os.path.join(folder, stem + ext)
     n = 1
-    while os.path.exists(path):
+    while os.path.exists(path) or path in _issued:
         path = os.path.join(folder, f"{stem}_{n:03d}{ext}")
         n += 1
+    _issued.add(path)
     return path
 
 
@@ -87,10 +95,10 @@ def blender_cell_offset(voxel_size):
     renders and Volume to Mesh come out shifted by +half a voxel on every
     axis (measured on 3.4.1: a Cycles render and VOLUME_TO_MESH of the sdf
     both sit 0.5 voxel above _native.isosurface). The file stays correct for
-    other tools; the object is moved back instead. Blender fixed this in
-    2025 (PR #138449); the version bound is checked by
-    tests/blender/test_voxelize.py::test_volume_lines_up_with_mesh.
+    other tools; the object is moved back instead. Measured with the add-on
+    tests (test_voxelize.py::test_volume_lines_up_with_mesh) in each release:
+    3.4.1, 4.2.23 and 4.5.15 shift by half a voxel; 5.0.0 and 5.0.1 do not.
     """
-    if bpy.app.version >= (4, 5, 0):
+    if bpy.app.version >= (5, 0, 0):
         return 0.0
     return 0.5 * voxel_size
