@@ -231,6 +231,34 @@ void bind_points(py::module_& m) {
       py::arg("seed") = std::uint64_t(0), py::arg("ctx") = static_cast<ExecContext*>(nullptr),
       "Grow the point texture over a target mesh (V by 3 vertices, F by 3 faces), its x axis along `field`\n"
       "(V by 3 tangents), `scale` target units per exemplar unit. Same result dict as synthesize_points.");
+  m.def(
+      "points_to_mesh",
+      [](const py::object& positions, const py::object& normals, double spacing, double radius, double voxel,
+         int smoothing, std::size_t memory_budget, ExecContext* ctx) {
+        OrientedPoints pts;
+        pts.positions = to_rows3(positions, "positions", "an N by 3 float32 or float64 array of points");
+        if (normals.is_none()) throw InvalidInput("'normals' is missing: points_to_mesh needs oriented points");
+        pts.normals = to_rows3(normals, "normals", "an N by 3 float32 or float64 array of unit normals");
+        PointMeshOptions o;
+        o.radius = radius;
+        o.voxel = voxel;
+        o.smoothing = smoothing;
+        o.memory_budget = memory_budget ? memory_budget : kDefaultMemoryBudget;
+        TriangleMesh mesh;
+        {
+          py::gil_scoped_release release;
+          mesh = points_to_mesh(pts, spacing, o, ctx);
+        }
+        std::vector<std::int32_t> faces(mesh.faces.size() * 3);
+        for (std::size_t i = 0; i < mesh.faces.size(); ++i)
+          for (int k = 0; k < 3; ++k) faces[3 * i + k] = mesh.faces[i][k];
+        return py::make_tuple(rows3(mesh.vertices), take_vector(std::move(faces), {py::ssize_t(mesh.faces.size()), 3}));
+      },
+      py::arg("positions"), py::arg("normals"), py::kw_only(), py::arg("spacing") = 0.0, py::arg("radius") = 1.5,
+      py::arg("voxel") = 0.5, py::arg("smoothing") = 1, py::arg("memory_budget") = std::size_t(0),
+      py::arg("ctx") = static_cast<ExecContext*>(nullptr),
+      "A mesh from oriented points (OpenVDB particles -> level set -> mesh): spheres of `radius` spacings inset\n"
+      "along the normals, voxels of `voxel` spacings (spacing <= 0: measured). Returns (vertices V by 3, faces F by 3).");
 }
 
 }  // namespace exsynth::py_bind

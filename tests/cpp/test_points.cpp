@@ -372,3 +372,15 @@ TEST(PointTextureOnMesh, StaysWithinTheTextureHeightAndFollowsTheField) {
   ASSERT_GT(s.points.size(), 1000u);
   for (const V3& p : s.points.positions) EXPECT_NEAR(p.norm(), 3.0f, 1.5f * 0.08f + 0.1f);
 }
+
+TEST(PointsToMesh, ASphereComesBackAsItsSurface) {
+  const OrientedPoints sphere = sphere_points(1.0f, 6000);
+  const TriangleMesh m = points_to_mesh(sphere);
+  ASSERT_GT(m.faces.size(), 1000u);
+  for (const V3& v : m.vertices) EXPECT_NEAR(v.norm(), 1.0f, 0.03f);
+  // Counter-clockwise seen from outside: positive enclosed volume, about the ball's.
+  EXPECT_NEAR(enclosed_volume(m), 4.0 / 3.0 * 3.14159265 * 1.0, 0.15);
+  OrientedPoints bad = sphere;
+  bad.normals.pop_back();
+  EXPECT_THROW(points_to_mesh(bad), InvalidInput);
+}

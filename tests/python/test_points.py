@@ -180,3 +180,14 @@ def test_cancel_from_another_thread_and_progress(bumps):
     done = _native.ExecContext()
     _native.synthesize_points(bumps["positions"], bumps["normals"], size=(0.5, 0.5), options=SMALL, ctx=done)
     assert done.progress == pytest.approx(1.0)
+
+
+def test_points_to_mesh_of_a_sphere():
+    v, f = _uv_sphere(1.0, 64, 32)
+    p, n = _native.sample_mesh_points(v, f, density=800, seed=2)
+    assert len(p) == pytest.approx(800 * 4 * np.pi, rel=0.02)
+    verts, faces = _native.points_to_mesh(p, n)
+    assert faces.dtype == np.int32 and faces.shape[1] == 3 and len(faces) > 500
+    np.testing.assert_allclose(np.linalg.norm(verts, axis=1), 1.0, atol=0.04)
+    with pytest.raises(_native.InvalidInputError, match="oriented"):
+        _native.points_to_mesh(p, None)

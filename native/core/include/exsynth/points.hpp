@@ -140,3 +140,26 @@ PointExemplar height_field_exemplar(const std::vector<float>& heights, int rows,
                                     ExecContext* ctx = nullptr);
 
 }  // namespace exsynth
+
+namespace exsynth {
+
+// ---- surface from the points ---------------------------------------------------
+
+struct PointMeshOptions {
+  double radius = 1.5;      ///< sphere radius, in point spacings
+  double voxel = 0.5;       ///< voxel size, in point spacings
+  int smoothing = 1;        ///< mean-curvature flow passes on the level set (0 = none)
+  std::size_t memory_budget = kDefaultMemoryBudget;
+  std::uint64_t seed = 0;   ///< unused: deterministic
+};
+
+/// A renderable mesh from an oriented point set: a sphere of radius r at
+/// p - r n for every point (tangent to the surface from inside, so the outer
+/// side of the union is the surface), OpenVDB's particles-to-level-set, a
+/// little smoothing, then volume-to-mesh. `spacing` <= 0: measured. Closed
+/// shapes come out as their surface; open sheets as a slab 2 r thick below
+/// them. Throws InvalidInput, OverBudget, Cancelled.
+TriangleMesh points_to_mesh(const OrientedPoints& points, double spacing = 0.0, const PointMeshOptions& opt = {},
+                            ExecContext* ctx = nullptr);
+
+}  // namespace exsynth
