@@ -255,7 +255,7 @@ void bind_points(py::module_& m) {
         return py::make_tuple(rows3(mesh.vertices), take_vector(std::move(faces), {py::ssize_t(mesh.faces.size()), 3}));
       },
       py::arg("positions"), py::arg("normals"), py::kw_only(), py::arg("spacing") = 0.0, py::arg("radius") = 1.5,
-      py::arg("voxel") = 0.5, py::arg("smoothing") = 1, py::arg("memory_budget") = std::size_t(0),
+      py::arg("voxel") = 0.75, py::arg("smoothing") = 1, py::arg("memory_budget") = std::size_t(0),
       py::arg("ctx") = static_cast<ExecContext*>(nullptr),
       "A mesh from oriented points (OpenVDB particles -> level set -> mesh): spheres of `radius` spacings inset\n"
       "along the normals, voxels of `voxel` spacings (spacing <= 0: measured). Returns (vertices V by 3, faces F by 3).");

@@ -147,7 +147,7 @@ namespace exsynth {
 
 struct PointMeshOptions {
   double radius = 1.5;      ///< sphere radius, in point spacings
-  double voxel = 0.5;       ///< voxel size, in point spacings
+  double voxel = 0.75;      ///< voxel size, in point spacings
   int smoothing = 1;        ///< mean-curvature flow passes on the level set (0 = none)
   std::size_t memory_budget = kDefaultMemoryBudget;
   std::uint64_t seed = 0;   ///< unused: deterministic

@@ -15,10 +15,13 @@ class OutputStore {
  public:
   explicit OutputStore(float cell) : cell_(cell) {}
 
-  std::uint32_t add(const Eigen::Vector3f& p, const Eigen::Vector3f& n) {
+  /// sigma: the point's surface variation (carried from the exemplar, so
+  /// patches need not recompute it for the points they overlap).
+  std::uint32_t add(const Eigen::Vector3f& p, const Eigen::Vector3f& n, float sigma = 0.0f) {
     const auto id = std::uint32_t(positions.size());
     positions.push_back(p);
     normals.push_back(n);
+    this->sigma.push_back(sigma);
     alive.push_back(1);
     buckets_[key(cell_of(p))].push_back(id);
     return id;
@@ -40,6 +43,7 @@ class OutputStore {
   }
 
   std::vector<Eigen::Vector3f> positions, normals;
+  std::vector<float> sigma;
   std::vector<char> alive;
 
  private:

@@ -256,23 +256,24 @@ bool two_ray_hit(const PointSurface& surface, const Eigen::Vector3f& p, const Ei
                  float step, Eigen::Vector3f& hit, Eigen::Vector3f& hit_n) {
   const SurfaceSample s0 = surface.evaluate(p);
   if (!s0.valid) return false;
+  float prev_f[2] = {s0.f, s0.f};
+  bool alive[2] = {true, true};
   for (float s = step; s <= reach; s += step)
-    for (float dir : {1.0f, -1.0f}) {
-      const SurfaceSample a = surface.evaluate(p + dir * (s - step) * n), b = surface.evaluate(p + dir * s * n);
-      if (!a.valid || !b.valid || (a.f > 0) == (b.f > 0)) continue;
-      float lo = s - step, hi = s, flo = a.f;
-      for (int it = 0; it < 8; ++it) {
-        const float mid = 0.5f * (lo + hi);
-        const SurfaceSample m = surface.evaluate(p + dir * mid * n);
-        if (!m.valid) break;
-        if ((m.f > 0) == (flo > 0)) {
-          lo = mid;
-          flo = m.f;
-        } else {
-          hi = mid;
-        }
+    for (int d = 0; d < 2; ++d) {
+      if (!alive[d]) continue;
+      const float dir = d == 0 ? 1.0f : -1.0f;
+      const SurfaceSample b = surface.evaluate(p + dir * s * n);
+      if (!b.valid) {
+        alive[d] = false;
+        continue;
       }
-      hit = p + dir * 0.5f * (lo + hi) * n;
+      if ((prev_f[d] > 0) == (b.f > 0)) {
+        prev_f[d] = b.f;
+        continue;
+      }
+      // Linear interpolation of f between the two samples, then one more evaluation for the normal.
+      const float t = prev_f[d] / (prev_f[d] - b.f);
+      hit = p + dir * (s - step + t * step) * n;
       const SurfaceSample e = surface.evaluate(hit);
       hit_n = e.valid ? e.normal : n;
       return true;
@@ -298,13 +299,15 @@ void PatchSolver::blend(std::vector<LocalPoint>& fresh, std::vector<char>& keep_
   // in `iters` steps (each re-projects from where the point now is).
   auto pull = [&](LocalPoint& pt, float w, const PointSurface& surface) {
     if (w <= 0) return;
+    float d2 = 0;
+    if (surface.nearest(pt.p, &d2) >= surface.size() || d2 > max_move * max_move) return;  // nothing to meet
     const float alpha = 1.0f - std::pow(1.0f - std::min(w, 0.999f), 1.0f / float(iters));
     const Eigen::Vector3f start = pt.p;
     for (int k = 0; k < iters; ++k) {
-      Projection pr = surface.project(pt.p, 5, float(1e-3 * h_));
+      Projection pr = surface.project(pt.p, 3, float(1e-2 * h_));
       if (!pr.converged || (pr.point - start).norm() > max_move) {
         Eigen::Vector3f hit, hit_n;
-        if (!two_ray_hit(surface, pt.p, pt.n, max_move, float(0.5 * h_), hit, hit_n)) return;
+        if (!two_ray_hit(surface, pt.p, pt.n, max_move, float(h_), hit, hit_n)) return;
         if (k == 0) fallbacks.fetch_add(1, std::memory_order_relaxed);
         pr.point = hit;
         pr.normal = hit_n;
@@ -398,7 +401,8 @@ void PatchSolver::place(const Chart& chart, std::uint64_t patch_id, OutputStore&
   std::vector<float> src_sigma;
   std::vector<LocalPoint> fresh = source_points(pick, src_sigma);
   if (!old.empty()) {
-    const std::vector<float> old_sigma = surface_variation(op, old_surface.index());
+    std::vector<float> old_sigma(old.size());
+    for (std::size_t i = 0; i < old.size(); ++i) old_sigma[i] = out.sigma[old_ids[i]];
     warp(fresh, src_sigma, old, old_sigma, covered);
   }
   t0 = lap(t0, stats_.times.warp);
@@ -422,7 +426,7 @@ void PatchSolver::place(const Chart& chart, std::uint64_t patch_id, OutputStore&
       if (keep_new[i]) world[i] = chart.to_world(fresh[i]);
   });
   for (std::size_t i = 0; i < fresh.size(); ++i)
-    if (keep_new[i]) out.add(world[i].p, world[i].n);
+    if (keep_new[i]) out.add(world[i].p, world[i].n, src_sigma[i]);
   ++stats_.patches;
   lap(t0, stats_.times.blend);
 }
