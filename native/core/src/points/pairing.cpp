@@ -75,20 +75,29 @@ std::vector<PointPair> greedy_pairs(const std::vector<PairPoint>& sources, const
       disp[k] = targets[pairs[k].target].p - at[k];
     }
     const search::PointIndex index(at);
-    for (Candidate& c : cands) {
-      const Eigen::Vector3f d = targets[c.target].p - sources[c.source].p;
-      const double len = d.norm();
-      index.radius(sources[c.source].p, 2.0f * r, near);  // weights beyond 2 r are below e^-4
-      double wsum = 0, g = 0;
-      for (const auto& [k, dist2] : near) {
-        if (pairs[k].source == c.source) continue;
-        const double w = std::exp(-double(dist2) * inv_r2);
-        const double lk = disp[k].norm();
-        const double dir = (len > 1e-12 && lk > 1e-12) ? 1.0 - double(d.dot(disp[k])) / (len * lk) : 0.0;
-        g += w * (opt.w_l * (len - lk) * (len - lk) / s2 + opt.w_d * dir);
-        wsum += w;
+    // Candidates are grouped by source (candidate_pairs emits them so): one
+    // neighbourhood query per source serves all its candidates.
+    for (std::size_t c0 = 0; c0 < cands.size();) {
+      std::size_t c1 = c0;
+      while (c1 < cands.size() && cands[c1].source == cands[c0].source) ++c1;
+      const Eigen::Vector3f& sp = sources[cands[c0].source].p;
+      index.radius(sp, 2.0f * r, near);  // weights beyond 2 r are below e^-4
+      for (std::size_t ci = c0; ci < c1; ++ci) {
+        Candidate& c = cands[ci];
+        const Eigen::Vector3f d = targets[c.target].p - sp;
+        const double len = d.norm();
+        double wsum = 0, g = 0;
+        for (const auto& [k, dist2] : near) {
+          if (pairs[k].source == c.source) continue;
+          const double w = std::exp(-double(dist2) * inv_r2);
+          const double lk = disp[k].norm();
+          const double dir = (len > 1e-12 && lk > 1e-12) ? 1.0 - double(d.dot(disp[k])) / (len * lk) : 0.0;
+          g += w * (opt.w_l * (len - lk) * (len - lk) / s2 + opt.w_d * dir);
+          wsum += w;
+        }
+        c.total = c.base + float(wsum > 0 ? g / wsum : 0.0);
       }
-      c.total = c.base + float(wsum > 0 ? g / wsum : 0.0);
+      c0 = c1;
     }
     pairs = accept_greedily(cands, sources.size(), targets.size());
   }

@@ -181,9 +181,18 @@ void PatchSolver::warp(std::vector<LocalPoint>& src, const std::vector<float>& s
                        const std::vector<LocalPoint>& old, const std::vector<float>& old_sigma,
                        const std::vector<char>& covered) {
   std::vector<PairPoint> sources, targets;
+  std::vector<std::size_t> in_overlap;
   for (std::size_t i = 0; i < src.size(); ++i) {
     const int c = column(src[i].p);
-    if (c >= 0 && covered[std::size_t(c)]) sources.push_back({src[i].p, src[i].n, src_sigma[i]});
+    if (c >= 0 && covered[std::size_t(c)]) in_overlap.push_back(i);
+  }
+  // At most one pair per metric cell survives, max_pairs in all: pairing
+  // every overlap point would cost 8x more for the same warp. Keep an even
+  // subset (every k-th, index order) of 4 max_pairs sources.
+  const std::size_t stride = std::max<std::size_t>(1, in_overlap.size() / (4 * std::size_t(opt_.max_pairs)));
+  for (std::size_t k = 0; k < in_overlap.size(); k += stride) {
+    const std::size_t i = in_overlap[k];
+    sources.push_back({src[i].p, src[i].n, src_sigma[i]});
   }
   for (std::size_t i = 0; i < old.size(); ++i)
     if (column(old[i].p) >= 0) targets.push_back({old[i].p, old[i].n, old_sigma[i]});

@@ -18,7 +18,7 @@ SurfaceSample PointSurface::evaluate(const Eigen::Vector3f& x) const {
   SurfaceSample s;
   if (positions_.empty()) return s;
   thread_local std::vector<std::pair<std::size_t, float>> near;
-  index_.radius(x, 3.0f * h_, near);
+  index_.radius(x, 2.5f * h_, near);  // weights beyond 2.5 h are below 0.2 %
   if (near.empty()) return s;
   const float inv_h2 = 1.0f / (h_ * h_);
   // Sums relative to x in float: the neighbours are within 3 h, so there is
@@ -59,7 +59,7 @@ Projection PointSurface::project(const Eigen::Vector3f& x0, int iterations, floa
   if (!p.converged && iterations > 0) {
     // Accept a last step that is small next to the bandwidth.
     const SurfaceSample s = evaluate(x);
-    p.converged = s.valid && std::abs(s.f) < 1e-3f * h_;
+    p.converged = s.valid && std::abs(s.f) < 0.05f * h_;  // within 5 % of the bandwidth: on the surface for blending
     if (s.valid) p.normal = s.normal;
   }
   return p;

@@ -18,7 +18,7 @@ struct SurfaceSample {
   float f = 0;                              ///< signed distance estimate (positive along the normals)
   Eigen::Vector3f normal = Eigen::Vector3f::Zero();  ///< n(x), unit; the field's gradient direction
   Eigen::Vector3f mean = Eigen::Vector3f::Zero();    ///< a(x)
-  bool valid = false;                       ///< false: no point within the cut-off (3 h)
+  bool valid = false;                       ///< false: no point within the cut-off (2.5 h)
 };
 
 struct Projection {
@@ -29,7 +29,7 @@ struct Projection {
 
 class PointSurface {
  public:
-  /// h: Gaussian width (weights exp(-d^2 / h^2), cut off at 3 h).
+  /// h: Gaussian width (weights exp(-d^2 / h^2), cut off at 2.5 h).
   PointSurface(const std::vector<Eigen::Vector3f>& positions, const std::vector<Eigen::Vector3f>& normals, float h);
 
   SurfaceSample evaluate(const Eigen::Vector3f& x) const;
