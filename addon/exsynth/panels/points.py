@@ -8,7 +8,6 @@ from .main import SidebarPanel, draw_field_preset, draw_shared_advanced
 
 class EXSYNTH_PT_point_texture(SidebarPanel, bpy.types.Panel):
     bl_label = "Point Texture"
-    bl_options = {'DEFAULT_CLOSED'}
 
     def draw(self, context):
         layout = self._layout()

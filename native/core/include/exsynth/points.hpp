@@ -146,7 +146,7 @@ namespace exsynth {
 // ---- surface from the points ---------------------------------------------------
 
 struct PointMeshOptions {
-  double radius = 1.5;      ///< sphere radius, in point spacings
+  double radius = 1.5;      ///< sphere radius, in point spacings (smaller leaves gaps between the spheres: the inner shell joins the outer)
   double voxel = 0.75;      ///< voxel size, in point spacings
   int smoothing = 1;        ///< mean-curvature flow passes on the level set (0 = none)
   std::size_t memory_budget = kDefaultMemoryBudget;
