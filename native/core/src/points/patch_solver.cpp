@@ -302,6 +302,10 @@ void PatchSolver::blend(std::vector<LocalPoint>& fresh, std::vector<char>& keep_
   }
   const PointSurface new_surface(fp, fn, float(h_));
   const float max_move = float(std::max(0.5 * extra_, 2.0 * h_));
+  // The rays look for the other sheet only nearby: a point whose projection
+  // ran off has, most often, no counterpart at all (measured: 37 % of the
+  // blended chainmail points tried the rays; reaching max_move cost 10 evaluations each).
+  const float ray_reach = std::min(max_move, float(3.0 * h_));
   const int iters = opt_.blend_iterations;
   std::atomic<std::size_t> fallbacks{0};
   // Moves p a total fraction w of the way to its projection on `surface`,
@@ -316,7 +320,7 @@ void PatchSolver::blend(std::vector<LocalPoint>& fresh, std::vector<char>& keep_
       Projection pr = surface.project(pt.p, 3, float(1e-2 * h_));
       if (!pr.converged || (pr.point - start).norm() > max_move) {
         Eigen::Vector3f hit, hit_n;
-        if (!two_ray_hit(surface, pt.p, pt.n, max_move, float(h_), hit, hit_n)) return;
+        if (!two_ray_hit(surface, pt.p, pt.n, ray_reach, float(h_), hit, hit_n)) return;
         if (k == 0) fallbacks.fetch_add(1, std::memory_order_relaxed);
         pr.point = hit;
         pr.normal = hit_n;
