@@ -263,6 +263,7 @@ def _parser():
     p.add_argument("--samples", type=_int, default=16, help="Cycles samples per pixel (default 16)")
     p.add_argument("--solid-size", type=_int, default=64, help="voxels along the solid's edge (default 64)")
     p.set_defaults(run=_run_demo)
+    _points_parser(sub)
     return parser
 
 
@@ -712,3 +713,110 @@ def _input_file(arg, path, allowed):
     mesh_files.check_indices(arg, path)  # what Blender's importers would drop silently
     return path
 
+
+# ---- points --------------------------------------------------------------------
+def _points_parser(sub):
+    from .operators import points as points_ops
+
+    p = sub.add_parser(
+        "points", help="grow a geometry texture (oriented points) over a plane or a mesh: .ply or .obj",
+        description="Patch-based geometry texture synthesis on point sets. The exemplar is a point file "
+        "with normals (.ply, .xyz, .pwn), a grey height-field image (one pixel = --pixel-size units, height "
+        "= grey / 255 x --height-scale) or a built-in (--preset, a 1 x 1 box: --size 4 4 asks for 16 "
+        "exemplar areas). Grows over --size W D of the reference plane or over --target MESH.",
+    )
+    ex = p.add_mutually_exclusive_group(required=True)
+    ex.add_argument("--exemplar", help="a point file (.ply with nx ny nz, .xyz, .pwn) or a grey image (.png)")
+    ex.add_argument("--preset", choices=points_ops.PRESETS, help="a built-in geometry texture")
+    out = p.add_mutually_exclusive_group(required=True)
+    out.add_argument("--size", type=_finite, nargs=2, metavar=("W", "D"), help="output area, exemplar units")
+    out.add_argument("--target", help="a mesh to cover (.obj, .ply, .stl; file coordinates)")
+    p.add_argument("--field-preset", choices=analogy_ops.FIELD_PRESETS[:2], default="around_axis",
+                   help="--target: the direction the texture's x axis follows (default around_axis)")
+    p.add_argument("--axis", type=_finite, nargs=3, metavar=("X", "Y", "Z"), default=(0.0, 0.0, 1.0),
+                   help="--field-preset's axis (default 0 0 1)")
+    p.add_argument("--scale", type=_finite, default=0.0,
+                   help="--target: target units per exemplar unit (default: 1/8 of the target's longest side)")
+    p.add_argument("--patch-size", type=_finite, default=0.0, help="patch side, exemplar units (default: preset's)")
+    p.add_argument("--density", type=_finite, default=8000.0,
+                   help="built-ins and height fields: points per unit area (height fields: per pixel^2 x "
+                   "this / 10000; default 8000)")
+    p.add_argument("--pixel-size", type=_finite, default=1.0, help="height field: units per pixel (default 1)")
+    p.add_argument("--height-scale", type=_finite, default=1.0, help="height field: height of white (default 1)")
+    p.add_argument("--out", required=True, help="the points: .ply (binary, with normals) or .obj (v + vn)")
+    p.add_argument("--mesh-out", help="also a surface made from the points: .obj")
+    p.add_argument("--seed", type=_seed, default=0, help="random seed (default 0)")
+    p.add_argument("--memory-budget", type=_gib, default=0.0, help="GiB (default: the engine's 8 GiB)")
+    p.set_defaults(run=_run_points)
+
+
+def _points_exemplar(args, points_ops):
+    from .io import point_files
+
+    if args.preset:
+        _require(args.density > 0, f"--density must be > 0 (got {args.density})")
+        return points_ops.Exemplar(name=args.preset, preset=args.preset, density=args.density), args.preset
+    path = _input_file("--exemplar", args.exemplar, None)
+    name = os.path.splitext(os.path.basename(path))[0]
+    if os.path.splitext(path)[1].lower() in (".ply", ".xyz", ".pwn"):
+        try:
+            pos, nrm = point_files.read_points(path)
+        except point_files.PointFileError as exc:
+            raise UsageError(f"--exemplar: {exc}")
+        return points_ops.Exemplar(name=name, positions=pos, normals=nrm), "default"
+    _require(args.pixel_size > 0, f"--pixel-size must be > 0 (got {args.pixel_size})")
+    image = image_io.load(path)
+    try:
+        grey = image_io.exemplar_pixels(image, role="height field")[::-1, :, 0]  # row 0 = y 0
+    finally:
+        bpy.data.images.remove(image)
+    heights = np.ascontiguousarray(grey * args.height_scale, np.float32)
+    pad = max(2, min(heights.shape) // 8)
+    ex = _native.height_field_exemplar(heights, pixel_size=args.pixel_size, padding=pad, seed=args.seed,
+                                       density=args.density / 10000.0 / args.pixel_size ** 2)
+    lo, hi = np.array(ex["box_min"]), np.array(ex["box_max"])
+    exemplar = points_ops.Exemplar(name=name, positions=ex["positions"] - np.r_[lo, 0.0], normals=ex["normals"])
+    exemplar.box = ((0.0, 0.0), tuple(hi - lo))
+    return exemplar, "default"
+
+
+def _run_points(args):
+    from .io import point_files
+    from .operators import points as points_ops
+
+    out = args.outputs.add("--out", args.out, (".ply", ".obj"))
+    mesh_out = args.outputs.add("--mesh-out", args.mesh_out, (".obj",)) if args.mesh_out else None
+    _require(args.patch_size >= 0, f"--patch-size must be > 0 (got {args.patch_size})")
+    exemplar, preset = _points_exemplar(args, points_ops)
+    options = _native.point_texture_preset(preset)
+    if args.patch_size > 0:
+        options["patch_size"] = args.patch_size
+    elif preset == "default" and getattr(exemplar, "box", None) is None and exemplar.positions is not None:
+        lo, hi = points_ops.user_box(exemplar.positions)
+        options["patch_size"] = 0.35 * float(min(np.subtract(hi, lo)))
+    elif getattr(exemplar, "box", None) is not None:
+        options["patch_size"] = 0.35 * float(min(exemplar.box[1]))
+    job = points_ops.PointTextureJob(exemplar=exemplar, options=options, make_mesh=bool(args.mesh_out),
+                                     memory_budget=int(args.memory_budget * GIB), seed=args.seed)
+    if args.size:
+        _require(min(args.size) > 0, f"--size must be two positive lengths (got {args.size[0]} {args.size[1]})")
+        job.size = tuple(args.size)
+    else:
+        path = _input_file("--target", args.target, MESH_FORMATS)
+        verts, tris = mesh_io.world_triangles(import_mesh(path), bpy.context.evaluated_depsgraph_get())
+        _require(len(tris) > 0, f"--target: {path} has no faces to cover")
+        _require(any(args.axis) and all(np.isfinite(args.axis)), "--axis must be a finite, non-zero direction")
+        job.target = points_ops.Target(name=os.path.splitext(os.path.basename(path))[0], vertices=verts,
+                                       triangles=tris, preset=args.field_preset, axis=tuple(args.axis))
+        longest = float((verts.max(0) - verts.min(0)).max())
+        job.scale = args.scale if args.scale > 0 else longest / 8.0
+    result, seconds = _run_job(job, "points")
+    point_files.write_points(out, result.positions, result.normals)
+    t = result.stats["times"]
+    line = (f"points: {exemplar.name} -> {len(result.positions)} points, {result.stats['patches']} patches, "
+            f"{result.stats['pairs']} pairs (search {t['search']:.2f} s, warp {t['warp']:.2f} s, blend "
+            f"{t['blend']:.2f} s, other {t['other']:.2f} s) in {seconds:.2f} s -> {args.out}")
+    if mesh_out:
+        export_obj(mesh_out, result.name.replace("_points", "_surface"), *result.surface)
+        line += f", {len(result.surface[1])} triangles -> {args.mesh_out}"
+    return line

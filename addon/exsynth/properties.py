@@ -261,6 +261,79 @@ class ExSynthSettings(bpy.types.PropertyGroup):
         default=False,
     )
 
+    # ---- Point Texture ------------------------------------------------------
+    pts_exemplar_source: EnumProperty(
+        name="Exemplar",
+        description="The geometry texture to grow: oriented points over a reference plane (z up)",
+        items=(
+            ('BUILTIN', "Built-in", "A generated geometry texture (bumps, chainmail, weave, flowers), 1 × 1 unit"),
+            ('OBJECT', "Object", "A mesh object, sampled evenly; its x, y bounds less 15 % per side are the box"),
+            ('SELECTED', "Selected Faces", "The faces selected on a mesh object, sampled evenly"),
+            ('FILE', "File", "A point file with normals: .ply (nx ny nz), .xyz or .pwn"),
+        ),
+        default='BUILTIN',
+    )
+    pts_preset: EnumProperty(
+        name="Texture",
+        description="The built-in geometry texture",
+        items=(('BUMPS', "Bumps", "Round bumps on a height field"),
+               ('CHAINMAIL', "Chainmail", "Interlocked rings (European 4-in-1)"),
+               ('WEAVE', "Weave", "Over-under tubes"),
+               ('FLOWERS', "Flowers", "Small flowers on stems over the ground")),
+        default='CHAINMAIL',
+    )
+    pts_object: PointerProperty(
+        name="Object", description="The mesh to sample the exemplar from (world units)",
+        type=bpy.types.Object, poll=lambda self, obj: obj.type == 'MESH',
+    )
+    pts_file: StringProperty(name="File", description="A .ply with normals, .xyz or .pwn", subtype='FILE_PATH')
+    pts_density: FloatProperty(
+        name="Density", description="Points per unit of surface area of the exemplar (more: finer, slower)",
+        default=8000.0, min=10.0, soft_max=200000.0,
+    )
+    pts_output: EnumProperty(
+        name="Output", description="Where the texture grows",
+        items=(('PLANE', "Plane", "Over a W × D area of the reference plane, at the 3D cursor"),
+               ('TARGET', "Target Mesh", "Over the surface of a mesh, following its direction field")),
+        default='PLANE',
+    )
+    pts_width: FloatProperty(name="Width", description="Output size along x, exemplar units", default=3.0,
+                             min=0.05, soft_max=50.0)
+    pts_depth: FloatProperty(name="Depth", description="Output size along y, exemplar units", default=3.0,
+                             min=0.05, soft_max=50.0)
+    pts_target: PointerProperty(
+        name="Target", description="The mesh to cover (its 'exsynth_field' attribute orients the texture, "
+        "otherwise the field preset)", type=bpy.types.Object, poll=lambda self, obj: obj.type == 'MESH',
+    )
+    pts_scale: FloatProperty(name="Scale", description="Target units per exemplar unit", default=0.1,
+                             min=1e-4, soft_max=10.0)
+    pts_field_preset: EnumProperty(name="Field", description="The direction the texture's x axis follows "
+                                   "on a target without an 'exsynth_field' attribute",
+                                   items=FIELD_PRESET_ITEMS, default='AROUND_AXIS')
+    pts_field_axis: EnumProperty(name="Axis", description="The field preset's axis, world coordinates",
+                                 items=(('X', "X", ""), ('Y', "Y", ""), ('Z', "Z", "")), default='Z')
+    pts_field_curve: PointerProperty(name="Curve", description="The curve the field follows",
+                                     type=bpy.types.Object, poll=lambda self, obj: obj.type == 'CURVE')
+    pts_patch_size: FloatProperty(name="Patch Size", description="Side of a patch, exemplar units (must fit in "
+                                  "the exemplar with room to spare)", default=0.5, min=0.01, soft_max=5.0)
+    pts_make_mesh: BoolProperty(name="Make Surface", description="Also add a mesh made from the points "
+                                "(OpenVDB particles to level set to mesh)", default=False)
+    pts_custom_weights: BoolProperty(name="Custom Weights", description="Use the weights below instead of "
+                                     "the texture's preset", default=False)
+    pts_extra: FloatProperty(name="Overlap", description="The overlap E as a fraction of the patch", default=0.3,
+                             min=0.1, max=0.5)
+    pts_epsilon: FloatProperty(name="Epsilon", description="Candidates within (1 + epsilon) of the best "
+                               "are picked at random", default=0.1, min=0.0, soft_max=1.0)
+    pts_w_p: FloatProperty(name="Position", description="Pairing: weight of the position difference",
+                           default=1.0, min=0.0)
+    pts_w_n: FloatProperty(name="Normal", description="Pairing: weight of the normal difference", default=1.0, min=0.0)
+    pts_w_v: FloatProperty(name="Variation", description="Pairing: weight of the surface-variation difference",
+                           default=1.0, min=0.0)
+    pts_w_l: FloatProperty(name="Length", description="Coherence: weight of displacement length differences",
+                           default=1.0, min=0.0)
+    pts_w_d: FloatProperty(name="Direction", description="Coherence: weight of displacement direction "
+                           "differences", default=1.0, min=0.0)
+
     @property
     def memory_budget_bytes(self) -> int:
         return max(1, int(self.memory_budget_gib * GIB))

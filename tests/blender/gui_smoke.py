@@ -220,6 +220,36 @@ def geo_pair_drawn():
             check(False, "the Geometric Texture panel draws with a mesh pair")
         return 0.1
     check(True, "the Geometric Texture panel draws with a mesh pair")
+    state.update(step="pts_start")
+    return 0.1
+
+
+# ---- Point Texture: its panel draws, its modal run finishes, Ctrl+Z undoes it
+def pts_start():
+    bpy.data.batch_remove(list(bpy.data.objects))
+    s = bpy.context.scene.exsynth
+    s.pts_preset, s.pts_density, s.pts_width, s.pts_depth, s.pts_patch_size = 'WEAVE', 2500.0, 1.5, 1.5, 0.5
+    _record_draws(bpy.types.EXSYNTH_PT_point_texture)
+    _in_viewport(lambda: bpy.ops.ed.undo_push(message="before Point Texture"))
+    check(invoke_in_viewport("point_texture") == {'RUNNING_MODAL'}, "Point Texture runs modal")
+    state.update(step="pts_finish", t0=time.monotonic())
+    return 0.05
+
+
+def pts_finish():
+    if "weave_points" not in bpy.data.objects:
+        if time.monotonic() - state["t0"] > 120:
+            check(False, "Point Texture finishes within two minutes")
+        return 0.05
+    check(names() == ["weave_points"], "Point Texture adds 'weave_points'")
+    check("EXSYNTH_PT_point_texture" in drawn, "the Point Texture panel draws without errors")
+    _in_viewport(lambda: bpy.ops.ed.undo())
+    state.update(step="pts_undone")
+    return 0.3
+
+
+def pts_undone():
+    check(names() == [], "one undo removes the Point Texture result")
     print("gui_smoke: all passed", flush=True)
     os._exit(0)
 
@@ -227,5 +257,6 @@ def geo_pair_drawn():
 STEPS = {"start": start, "wait_finish": wait_finish, "press_esc": press_esc, "after_esc": after_esc,
          "solid_start": solid_start, "find_tab": find_tab, "solid_finish": solid_finish,
          "geo_start": geo_start, "geo_finish": geo_finish, "geo_undone": geo_undone,
-         "geo_pair_drawn": geo_pair_drawn}
+         "geo_pair_drawn": geo_pair_drawn, "pts_start": pts_start, "pts_finish": pts_finish,
+         "pts_undone": pts_undone}
 bpy.app.timers.register(step, first_interval=1.0)

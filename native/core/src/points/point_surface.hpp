@@ -1,0 +1,59 @@
+#pragma once
+// Adamson & Alexa's point-set surface: at x, a(x) is the Gaussian-weighted
+// mean of the points near x and n(x) the normalised weighted mean of their
+// normals; the surface is f(x) = n(x) . (x - a(x)) = 0. Projection iterates
+// x <- x - f(x) n(x) (their quasi-orthogonal projection). Built once over a
+// point set, queried from many threads (queries are const).
+#include <cstddef>
+#include <memory>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "search/point_index.hpp"
+
+namespace exsynth::points {
+
+struct SurfaceSample {
+  float f = 0;                              ///< signed distance estimate (positive along the normals)
+  Eigen::Vector3f normal = Eigen::Vector3f::Zero();  ///< n(x), unit; the field's gradient direction
+  Eigen::Vector3f mean = Eigen::Vector3f::Zero();    ///< a(x)
+  bool valid = false;                       ///< false: no point within the cut-off (2.5 h)
+};
+
+struct Projection {
+  Eigen::Vector3f point = Eigen::Vector3f::Zero();
+  Eigen::Vector3f normal = Eigen::Vector3f::Zero();
+  bool converged = false;
+};
+
+class PointSurface {
+ public:
+  /// h: Gaussian width (weights exp(-d^2 / h^2), cut off at 2.5 h).
+  PointSurface(const std::vector<Eigen::Vector3f>& positions, const std::vector<Eigen::Vector3f>& normals, float h);
+
+  SurfaceSample evaluate(const Eigen::Vector3f& x) const;
+  /// At most `iterations` steps; converged when a step is below tol.
+  Projection project(const Eigen::Vector3f& x, int iterations = 8, float tol = 1e-5f) const;
+  /// Nearest point's index (size() when empty) and squared distance.
+  std::size_t nearest(const Eigen::Vector3f& x, float* d2 = nullptr) const;
+  const search::PointIndex& index() const { return index_; }
+  float bandwidth() const { return h_; }
+  std::size_t size() const { return positions_.size(); }
+
+ private:
+  const std::vector<Eigen::Vector3f>& positions_;
+  const std::vector<Eigen::Vector3f>& normals_;
+  float h_;
+  search::PointIndex index_;
+};
+
+/// Surface variation sigma = l0 / (l0 + l1 + l2) of the k nearest points'
+/// covariance (Pauly et al.), per point; 0 on a plane, 1/3 isotropic.
+std::vector<float> surface_variation(const std::vector<Eigen::Vector3f>& positions, const search::PointIndex& index,
+                                     int k = 12);
+
+/// Mean distance from each point to its nearest other point.
+double mean_spacing(const std::vector<Eigen::Vector3f>& positions, const search::PointIndex& index);
+
+}  // namespace exsynth::points

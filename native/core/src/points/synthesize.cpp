@@ -1,0 +1,269 @@
+// Entry points of the point-set geometry texture synthesis: over a plane
+// (scan-line patches) and over a target mesh (patches at evenly spread
+// centres in front order), then crop and density relaxation.
+#include <algorithm>
+#include <cmath>
+#include <chrono>
+#include <limits>
+#include <numeric>
+#include <queue>
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include "exsynth/errors.hpp"
+#include "exsynth/field.hpp"
+#include "exsynth/parallel.hpp"
+#include "exsynth/points.hpp"
+#include <Eigen/Geometry>
+
+#include "points/patch_solver.hpp"
+#include "points/sampling.hpp"
+
+namespace exsynth {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+using V3 = Eigen::Vector3f;
+
+// Density relaxation: drop a point that has an earlier one (index order)
+// closer than half the spacing on a like-oriented sheet (where two patches'
+// points ended up doubled), then a few Jacobi rounds of tangential
+// repulsion between like-oriented neighbours. Deterministic: every point
+// reads the previous round only.
+OrientedPoints relax(OrientedPoints pts, double spacing, int rounds, ExecContext* ctx) {
+  if (pts.size() < 2 || rounds <= 0) return pts;
+  {
+    StageProgress progress(ctx, "relaxing the density", 0.9, 0.95, pts.size());
+    const search::PointIndex index(pts.positions);
+    std::vector<char> drop(pts.size(), 0);
+    const float r = float(0.5 * spacing);
+    parallel_chunks(pts.size(), 4096, progress, [&](std::size_t b, std::size_t e) {
+      std::vector<std::pair<std::size_t, float>> near;
+      for (std::size_t i = b; i < e; ++i) {
+        index.radius(pts.positions[i], r, near);
+        for (const auto& [j, d2] : near)
+          if (j < i && pts.normals[j].dot(pts.normals[i]) > 0.5f) {
+            drop[i] = 1;
+            break;
+          }
+      }
+    });
+    OrientedPoints kept;
+    for (std::size_t i = 0; i < pts.size(); ++i)
+      if (!drop[i]) {
+        kept.positions.push_back(pts.positions[i]);
+        kept.normals.push_back(pts.normals[i]);
+      }
+    pts = std::move(kept);
+  }
+  StageProgress progress(ctx, "relaxing the density", 0.95, 1.0, pts.size() * std::size_t(rounds));
+  const float r = float(1.5 * spacing);
+  for (int round = 0; round < rounds; ++round) {
+    const search::PointIndex index(pts.positions);
+    std::vector<V3> next(pts.positions);
+    parallel_chunks(pts.size(), 4096, progress, [&](std::size_t b, std::size_t e) {
+      std::vector<std::pair<std::size_t, float>> near;
+      for (std::size_t i = b; i < e; ++i) {
+        const V3& p = pts.positions[i];
+        const V3& n = pts.normals[i];
+        index.radius(p, r, near);
+        V3 force = V3::Zero();
+        for (const auto& [j, d2] : near) {
+          if (j == i || pts.normals[j].dot(n) < 0.7f) continue;
+          const float d = std::sqrt(d2);
+          if (d < 1e-9f) continue;
+          force += (p - pts.positions[j]) / d * (1.0f - d / r);
+        }
+        force -= force.dot(n) * n;  // stay on the surface: move in the tangent plane
+        V3 step = 0.1f * float(spacing) * force;
+        const float len = step.norm(), cap = 0.25f * float(spacing);
+        if (len > cap) step *= cap / len;
+        next[i] = p + step;
+      }
+    });
+    pts.positions = std::move(next);
+  }
+  return pts;
+}
+
+void finish_density(PointTextureResult& r, const PointExemplar& ex) {
+  std::size_t inside = 0;
+  for (const auto& p : ex.points.positions)
+    inside += p.x() >= ex.box_min.x() && p.x() <= ex.box_max.x() && p.y() >= ex.box_min.y() && p.y() <= ex.box_max.y();
+  r.density = double(inside) / ((ex.box_max.x() - ex.box_min.x()) * (ex.box_max.y() - ex.box_min.y()));
+}
+
+}  // namespace
+
+PointTextureResult synthesize_points(const PointExemplar& exemplar, double width, double depth,
+                                     const PointTextureOptions& opt, ExecContext* ctx) {
+  const auto t_start = Clock::now();
+  if (!(width > 0) || !(depth > 0) || !std::isfinite(width) || !std::isfinite(depth))
+    throw InvalidInput("the output size (width, depth) must be positive lengths in exemplar units");
+  points::PatchSolver solver(exemplar, opt, ctx);
+  PointTextureResult result;
+  finish_density(result, exemplar);
+  const double P = solver.patch(), E = solver.overlap(), s = P - E;
+  const int nx = 1 + int(std::ceil(std::max(0.0, width + 2 * E - P) / s));
+  const int ny = 1 + int(std::ceil(std::max(0.0, depth + 2 * E - P) / s));
+  const double est = result.density * (width + 2 * E) * (depth + 2 * E) * 1.5;
+  check_memory_budget(est * 120.0, opt.memory_budget, "a point texture of about " + std::to_string(std::llround(est)) + " points",
+                      "lower the output size or the exemplar's density");
+  points::OutputStore out(float(0.5 * P));
+  {
+    StageProgress progress(ctx, "placing patches", 0.05, 0.9, std::size_t(nx) * ny);
+    for (int j = 0; j < ny; ++j)
+      for (int i = 0; i < nx; ++i) {
+        progress.check();
+        const points::PlaneChart chart(float(-E + 0.5 * P + i * s), float(-E + 0.5 * P + j * s));
+        solver.place(chart, std::uint64_t(j) * std::uint64_t(nx) + std::uint64_t(i), out);
+        progress.advance();
+      }
+  }
+  OrientedPoints alive;
+  for (std::size_t i = 0; i < out.positions.size(); ++i)
+    if (out.alive[i]) {
+      alive.positions.push_back(out.positions[i]);
+      alive.normals.push_back(out.normals[i]);
+    }
+  // Relax with the border strip still there (whole neighbourhoods), then crop it.
+  alive = relax(std::move(alive), solver.spacing(), opt.relax_iterations, ctx);
+  for (std::size_t i = 0; i < alive.size(); ++i) {
+    const V3& p = alive.positions[i];
+    if (p.x() >= 0 && p.x() <= width && p.y() >= 0 && p.y() <= depth) {
+      result.points.positions.push_back(p);
+      result.points.normals.push_back(alive.normals[i]);
+    }
+  }
+  const PointTextureResult& st = solver.stats();
+  result.patches = st.patches;
+  result.pairs = st.pairs;
+  result.fallbacks = st.fallbacks;
+  result.spacing = st.spacing;
+  result.times = st.times;
+  const double total = std::chrono::duration<double>(Clock::now() - t_start).count();
+  result.times.other = std::max(0.0, total - result.times.search - result.times.warp - result.times.blend);
+  return result;
+}
+
+namespace {
+
+// Patch centres on the target: Poisson-disk picks from its samples (index
+// order, radius r), visited outward from the first along a k-nearest graph
+// (Dijkstra), so each patch overlaps patches already placed, as scan lines do on a plane.
+std::vector<V3> patch_centres(const std::vector<V3>& samples, float r) {
+  points::OutputStore picked(r);
+  std::vector<std::uint32_t> near;
+  std::vector<V3> centres;
+  for (const V3& p : samples) {
+    picked.gather(p, r, near);
+    if (near.empty()) {
+      picked.add(p, V3::UnitZ());
+      centres.push_back(p);
+    }
+  }
+  const search::PointIndex index(centres);
+  const std::size_t k = std::min<std::size_t>(9, centres.size());
+  std::vector<double> dist(centres.size(), std::numeric_limits<double>::infinity());
+  std::vector<char> done(centres.size(), 0);
+  std::vector<std::size_t> order;
+  using Item = std::pair<double, std::size_t>;
+  std::vector<std::size_t> idx(k);
+  std::vector<float> d2(k);
+  for (std::size_t start = 0; start < centres.size(); ++start) {
+    if (done[start]) continue;  // a new component: start again from its first centre
+    std::priority_queue<Item, std::vector<Item>, std::greater<Item>> heap;
+    dist[start] = 0;
+    heap.push({0.0, start});
+    while (!heap.empty()) {
+      const auto [d, i] = heap.top();
+      heap.pop();
+      if (done[i]) continue;
+      done[i] = 1;
+      order.push_back(i);
+      const std::size_t m = index.knn(centres[i], k, idx.data(), d2.data());
+      for (std::size_t q = 0; q < m; ++q) {
+        const std::size_t j = idx[q];
+        const double nd = d + std::sqrt(double(d2[q]));
+        if (!done[j] && nd < dist[j]) {
+          dist[j] = nd;
+          heap.push({nd, j});
+        }
+      }
+    }
+  }
+  std::vector<V3> ordered;
+  for (std::size_t i : order) ordered.push_back(centres[i]);
+  return ordered;
+}
+
+}  // namespace
+
+PointTextureResult synthesize_points_on_mesh(const PointExemplar& exemplar, const TriangleMesh& target,
+                                             const std::vector<V3>& field, double scale,
+                                             const PointTextureOptions& opt, ExecContext* ctx) {
+  const auto t_start = Clock::now();
+  validate_mesh(target, "target mesh");
+  if (field.size() != target.vertices.size())
+    throw InvalidInput("the direction field has " + std::to_string(field.size()) + " vectors for " +
+                       std::to_string(target.vertices.size()) + " vertices of the target; give one per vertex");
+  for (const V3& f : field)
+    if (!f.allFinite()) throw InvalidInput("the direction field has NaN or infinite vectors");
+  if (!(scale > 0) || !std::isfinite(scale))
+    throw InvalidInput("the scale (target units per exemplar unit) must be a positive number");
+  points::PatchSolver solver(exemplar, opt, ctx);
+  PointTextureResult result;
+  finish_density(result, exemplar);
+  const double area = points::surface_area(target);
+  const double est = result.density * area / (scale * scale) * 1.5;
+  check_memory_budget(est * 160.0, opt.memory_budget, "a point texture of about " + std::to_string(std::llround(est)) + " points",
+                      "lower the target's size relative to the scale, or the exemplar's density");
+  // The target as a point-set surface, sampled a few times finer than the metric grid.
+  const double cell_world = solver.patch() / opt.grid_resolution * scale;
+  const std::size_t count = std::size_t(std::clamp(area / (cell_world * cell_world) * 2.0, 2000.0, 400000.0));
+  points::SurfaceSamples samples = points::sample_surface(target, count, opt.seed, nullptr);
+  points::TargetSurface surface;
+  surface.positions = std::move(samples.points.positions);
+  surface.normals = std::move(samples.points.normals);
+  surface.field.resize(surface.positions.size());
+  for (std::size_t i = 0; i < surface.positions.size(); ++i) {
+    const auto& f = target.faces[samples.face[i]];
+    const V3& w = samples.bary[i];
+    surface.field[i] = w[0] * field[f[0]] + w[1] * field[f[1]] + w[2] * field[f[2]];
+  }
+  const search::PointIndex index(surface.positions);
+  const double target_spacing = points::mean_spacing(surface.positions, index);
+  const float max_height = std::max(std::abs(solver.z_min()), std::abs(solver.z_max()));
+  surface.surface = std::make_unique<points::PointSurface>(
+      surface.positions, surface.normals, float(std::max(2.0 * target_spacing, 0.25 * max_height * scale)));
+  const std::vector<V3> centres = patch_centres(surface.positions, float(0.42 * solver.patch() * scale));
+  points::OutputStore out(float(0.5 * solver.patch() * scale));
+  {
+    StageProgress progress(ctx, "placing patches on the target", 0.05, 0.9, centres.size());
+    for (std::size_t c = 0; c < centres.size(); ++c) {
+      progress.check();
+      const points::SurfaceChart chart(surface, centres[c], float(scale), max_height);
+      solver.place(chart, c, out);
+      progress.advance();
+    }
+  }
+  OrientedPoints alive;
+  for (std::size_t i = 0; i < out.positions.size(); ++i)
+    if (out.alive[i]) {
+      alive.positions.push_back(out.positions[i]);
+      alive.normals.push_back(out.normals[i]);
+    }
+  result.points = relax(std::move(alive), solver.spacing() * scale, opt.relax_iterations, ctx);
+  const PointTextureResult& st = solver.stats();
+  result.patches = st.patches;
+  result.pairs = st.pairs;
+  result.fallbacks = st.fallbacks;
+  result.spacing = st.spacing;
+  result.times = st.times;
+  const double total = std::chrono::duration<double>(Clock::now() - t_start).count();
+  result.times.other = std::max(0.0, total - result.times.search - result.times.warp - result.times.blend);
+  return result;
+}
+
+}  // namespace exsynth

@@ -1,0 +1,32 @@
+#pragma once
+// A 3-D thin-plate (biharmonic) spline f(x) = A x + b + sum_i w_i |x - c_i|
+// mapping source centres c_i to targets y_i exactly (up to a small
+// regularisation), with its Jacobian for transforming normals: a normal n
+// becomes J^-T n (normalised), which keeps it perpendicular to the warped surface.
+#include <vector>
+
+#include <Eigen/Core>
+
+namespace exsynth::points {
+
+class ThinPlateSpline {
+ public:
+  ThinPlateSpline() = default;
+  /// Throws InvalidInput when there are fewer than 4 pairs or the system is singular.
+  ThinPlateSpline(const std::vector<Eigen::Vector3d>& sources, const std::vector<Eigen::Vector3d>& targets,
+                  double regularization = 0.0);
+
+  Eigen::Vector3d apply(const Eigen::Vector3d& x) const;
+  Eigen::Matrix3d jacobian(const Eigen::Vector3d& x) const;
+  /// J^-T n normalised (n itself where J is singular).
+  Eigen::Vector3d transform_normal(const Eigen::Vector3d& x, const Eigen::Vector3d& n) const;
+  bool empty() const { return centres_.empty(); }
+
+ private:
+  std::vector<Eigen::Vector3d> centres_;
+  std::vector<Eigen::Vector3d> weights_;  ///< one per centre
+  Eigen::Matrix3d linear_ = Eigen::Matrix3d::Identity();  ///< A
+  Eigen::Vector3d offset_ = Eigen::Vector3d::Zero();      ///< b
+};
+
+}  // namespace exsynth::points

@@ -1,0 +1,386 @@
+// Point-set geometry texture synthesis: the point-set surface, its field,
+// the thin-plate spline, the pairing, and the synthesis end to end.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <random>
+
+#include <tbb/global_control.h>
+
+#include "exsynth/errors.hpp"
+#include "exsynth/points.hpp"
+#include "points/pairing.hpp"
+#include "points/patch_solver.hpp"
+#include "points/point_surface.hpp"
+#include "points/sampling.hpp"
+#include "points/tps.hpp"
+#include "support/shapes.hpp"
+
+using namespace exsynth;
+using V3 = Eigen::Vector3f;
+
+namespace {
+
+OrientedPoints sphere_points(float radius, int n) {
+  // Fibonacci sphere: even, deterministic.
+  OrientedPoints s;
+  const double golden = 3.14159265358979 * (3.0 - std::sqrt(5.0));
+  for (int i = 0; i < n; ++i) {
+    const double z = 1.0 - 2.0 * (i + 0.5) / n, r = std::sqrt(1 - z * z), a = golden * i;
+    const V3 d(float(r * std::cos(a)), float(r * std::sin(a)), float(z));
+    s.positions.push_back(radius * d);
+    s.normals.push_back(d);
+  }
+  return s;
+}
+
+OrientedPoints plane_points(int n, float step) {
+  OrientedPoints s;
+  for (int j = 0; j < n; ++j)
+    for (int i = 0; i < n; ++i) {
+      s.positions.emplace_back(i * step, j * step, 0.0f);
+      s.normals.push_back(V3::UnitZ());
+    }
+  return s;
+}
+
+// Brute-force twin of PointSurface::evaluate: every point, no cut-off.
+points::SurfaceSample evaluate_all(const OrientedPoints& pts, const V3& x, float h) {
+  double wsum = 0;
+  Eigen::Vector3d a = Eigen::Vector3d::Zero(), n = Eigen::Vector3d::Zero();
+  for (std::size_t i = 0; i < pts.size(); ++i) {
+    const double w = std::exp(-double((pts.positions[i] - x).squaredNorm()) / (double(h) * h));
+    wsum += w;
+    a += w * pts.positions[i].cast<double>();
+    n += w * pts.normals[i].cast<double>();
+  }
+  points::SurfaceSample s;
+  a /= wsum;
+  n.normalize();
+  s.f = float(n.dot(x.cast<double>() - a));
+  s.normal = n.cast<float>();
+  s.valid = true;
+  return s;
+}
+
+PointTextureOptions small_options() {
+  PointTextureOptions o;
+  o.patch_size = 0.4;
+  o.grid_resolution = 8;
+  return o;
+}
+
+const PointExemplar& bumps_exemplar() {
+  static const PointExemplar ex = make_point_exemplar("bumps", 3000.0, 0.35, 1);
+  return ex;
+}
+
+}  // namespace
+
+TEST(PointSurface, ProjectionConvergesOntoSphereAndPlane) {
+  const OrientedPoints sphere = sphere_points(1.0f, 4000);
+  const points::PointSurface s(sphere.positions, sphere.normals, 0.06f);
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<float> u(-1, 1), rr(0.93f, 1.07f);
+  for (int k = 0; k < 200; ++k) {
+    const V3 d = V3(u(rng), u(rng), u(rng)).normalized();
+    const points::Projection p = s.project(rr(rng) * d, 20, 1e-7f);
+    ASSERT_TRUE(p.converged);
+    EXPECT_NEAR(p.point.norm(), 1.0f, 3e-3f);
+    EXPECT_GT(p.normal.dot(d), 0.999f);
+  }
+  const OrientedPoints plane = plane_points(30, 0.05f);
+  const points::PointSurface ps(plane.positions, plane.normals, 0.1f);
+  for (int k = 0; k < 50; ++k) {
+    const V3 x(0.3f + 0.8f * (u(rng) + 1) / 2, 0.3f + 0.8f * (u(rng) + 1) / 2, 0.2f * u(rng));
+    const points::Projection p = ps.project(x);
+    ASSERT_TRUE(p.converged);
+    EXPECT_NEAR(p.point.z(), 0.0f, 1e-5f);
+    EXPECT_NEAR(p.point.x(), x.x(), 1e-5f);  // orthogonal: no sliding along the plane
+  }
+}
+
+TEST(PointSurface, MatchesBruteForceAndExactSphereField) {
+  const OrientedPoints sphere = sphere_points(1.0f, 3000);
+  const float h = 0.08f;
+  const points::PointSurface s(sphere.positions, sphere.normals, h);
+  std::vector<V3> cells;
+  for (int k = 0; k < 300; ++k) {
+    const float a = 0.37f * k, b = 0.11f * k;
+    const float r = 0.9f + 0.2f * float(k % 11) / 10.0f;
+    cells.push_back(r * V3(std::cos(a) * std::cos(b), std::sin(a) * std::cos(b), std::sin(b)));
+  }
+  std::vector<float> f;
+  std::vector<V3> n;
+  points::PatchSolver::sample_field(s, cells, 0.5f, f, n);
+  for (std::size_t i = 0; i < cells.size(); ++i) {
+    const points::SurfaceSample ref = evaluate_all(sphere, cells[i], h);
+    EXPECT_NEAR(f[i], ref.f, 2e-3f);  // the k-d tree's 3 h cut-off drops weights below e^-9
+    EXPECT_GT(n[i].dot(ref.normal), 0.9999f);
+    const float exact = cells[i].norm() - 1.0f;
+    EXPECT_NEAR(f[i], exact, 0.01f) << "at radius " << cells[i].norm();
+    EXPECT_GT(n[i].dot(cells[i].normalized()), 0.999f);
+  }
+}
+
+TEST(ThinPlateSpline, InterpolatesPairsAndJacobianNormalsMatchFiniteDifferences) {
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> u(-1, 1);
+  std::vector<Eigen::Vector3d> from, to;
+  for (int i = 0; i < 30; ++i) {
+    const Eigen::Vector3d x(u(rng), u(rng), 0.3 * u(rng));
+    from.push_back(x);
+    to.push_back(x + 0.1 * Eigen::Vector3d(std::sin(3 * x.y()), std::cos(2 * x.x()), x.x() * x.y()));
+  }
+  const points::ThinPlateSpline tps(from, to);
+  for (std::size_t i = 0; i < from.size(); ++i) EXPECT_LT((tps.apply(from[i]) - to[i]).norm(), 1e-8);
+  for (int k = 0; k < 20; ++k) {
+    const Eigen::Vector3d x(0.8 * u(rng), 0.8 * u(rng), 0.2 * u(rng));
+    const Eigen::Vector3d n = Eigen::Vector3d(u(rng), u(rng), u(rng)).normalized();
+    const Eigen::Vector3d t1 = n.unitOrthogonal(), t2 = n.cross(t1);
+    const double e = 1e-5;
+    const Eigen::Vector3d d1 = tps.apply(x + e * t1) - tps.apply(x - e * t1);
+    const Eigen::Vector3d d2 = tps.apply(x + e * t2) - tps.apply(x - e * t2);
+    const Eigen::Vector3d fd = d1.cross(d2).normalized();  // the warped tangent plane's normal
+    EXPECT_GT(tps.transform_normal(x, n).dot(fd), 1 - 1e-6);
+  }
+}
+
+TEST(Pairing, CoherenceAvoidsCrossings) {
+  // Sources on a line; targets shifted by 0.5 with an alternating jitter:
+  // nearest-first pairing alone crosses pairs, the coherence rounds do not.
+  std::vector<points::PairPoint> src, dst;
+  for (int i = 0; i < 16; ++i) {
+    src.push_back({V3(float(i), 0, 0), V3::UnitZ(), 0});
+    dst.push_back({V3(float(i) + 0.5f + ((i % 2) ? 0.35f : -0.35f), 0.2f, 0), V3::UnitZ(), 0});
+  }
+  auto crossings = [&](const std::vector<points::PointPair>& pairs) {
+    int c = 0;
+    for (std::size_t a = 0; a < pairs.size(); ++a)
+      for (std::size_t b = a + 1; b < pairs.size(); ++b) {
+        const float ds = src[pairs[a].source].p.x() - src[pairs[b].source].p.x();
+        const float dt = dst[pairs[a].target].p.x() - dst[pairs[b].target].p.x();
+        c += ds * dt < 0;
+      }
+    return c;
+  };
+  points::PairingOptions o;
+  o.spacing = 1.0;
+  o.max_distance = 2.0;
+  o.w_l = 4.0;
+  o.w_d = 4.0;
+  o.coherence_radius = 2.0;
+  o.iterations = 1;
+  const auto greedy = points::greedy_pairs(src, dst, o);
+  EXPECT_GT(crossings(greedy), 0) << "the test case must make plain greedy pairing cross";
+  o.iterations = 4;
+  const auto coherent = points::greedy_pairs(src, dst, o);
+  EXPECT_EQ(crossings(coherent), 0);
+  EXPECT_GE(coherent.size(), 12u);
+}
+
+TEST(Sampling, ExactCountEvenAndOnTheSurface) {
+  const TriangleMesh sphere = exsynth::testing::icosphere(1.0f, 4);
+  const points::SurfaceSamples s = points::sample_surface(sphere, 2000, 7, nullptr);
+  ASSERT_EQ(s.points.size(), 2000u);
+  const search::PointIndex index(s.points.positions);
+  std::size_t idx[2];
+  float d2[2];
+  double min_d = 1e9;
+  for (const V3& p : s.points.positions) {
+    EXPECT_NEAR(p.norm(), 1.0f, 0.01f);
+    index.knn(p, 2, idx, d2);
+    min_d = std::min(min_d, std::sqrt(double(d2[1])));
+  }
+  // Blue noise: no two samples much closer than the packing radius (uniform random would give ~0.001).
+  const double r_max = std::sqrt(points::surface_area(sphere) / (2 * std::sqrt(3.0) * 2000));
+  EXPECT_GT(min_d, 0.4 * r_max);
+}
+
+TEST(PointTexture, CoversTheAreaAtTheExemplarDensity) {
+  const PointExemplar& ex = bumps_exemplar();
+  const PointTextureResult r = synthesize_points(ex, 2.0, 1.5, small_options());
+  ASSERT_GT(r.points.size(), 0u);
+  EXPECT_GT(r.patches, 20u);
+  EXPECT_GT(r.pairs, 0u);
+  // Density per cell of a 8 x 6 grid of 0.25 x 0.25 against the exemplar's
+  // own count in cells of the same size (its box, 4 x 4 cells).
+  auto counts = [](const std::vector<V3>& pts, double w, double d) {
+    const int nx = int(std::lround(w / 0.25)), ny = int(std::lround(d / 0.25));
+    std::vector<int> c(std::size_t(nx) * ny, 0);
+    for (const V3& p : pts)
+      if (p.x() >= 0 && p.y() >= 0 && p.x() < w && p.y() < d) ++c[std::size_t(int(p.y() / 0.25)) * nx + int(p.x() / 0.25)];
+    return c;
+  };
+  const std::vector<int> ref = counts(ex.points.positions, 1.0, 1.0);
+  double mean = 0;
+  for (int c : ref) mean += c;
+  mean /= double(ref.size());
+  for (const V3& p : r.points.positions) {
+    ASSERT_GE(p.x(), 0.0f);
+    ASSERT_LE(p.x(), 2.0f + 0.05f);
+    ASSERT_GE(p.y(), 0.0f);
+  }
+  const std::vector<int> out = counts(r.points.positions, 2.0, 1.5);
+  for (std::size_t i = 0; i < out.size(); ++i) {
+    EXPECT_GT(out[i], 0.6 * mean) << "cell " << i << " (a hole?)";
+    EXPECT_LT(out[i], 1.4 * mean) << "cell " << i << " (doubled points?)";
+  }
+}
+
+TEST(PointTexture, SeamsAreBounded) {
+  // Normal jumps between neighbouring output points against the same
+  // statistic in the exemplar: a seam would show as a heavy tail.
+  const PointExemplar& ex = bumps_exemplar();
+  const PointTextureResult r = synthesize_points(ex, 1.5, 1.5, small_options());
+  auto p99 = [&](const OrientedPoints& pts, double spacing) {
+    const search::PointIndex index(pts.positions);
+    std::vector<float> jump;
+    std::vector<std::pair<std::size_t, float>> near;
+    for (std::size_t i = 0; i < pts.size(); ++i) {
+      index.radius(pts.positions[i], float(1.5 * spacing), near);
+      for (const auto& [j, d2] : near)
+        if (j > i) jump.push_back(1.0f - pts.normals[i].dot(pts.normals[j]));
+    }
+    std::sort(jump.begin(), jump.end());
+    return jump[jump.size() * 99 / 100];
+  };
+  const double s = r.spacing;
+  const float ref = p99(ex.points, s), out = p99(r.points, s);
+  EXPECT_LT(out, 3.0f * ref + 0.02f) << "exemplar p99 " << ref;
+  // Heights stay within the exemplar's range (no point thrown off the texture).
+  float zlo = 1e9f, zhi = -1e9f;
+  for (const V3& p : ex.points.positions) {
+    zlo = std::min(zlo, p.z());
+    zhi = std::max(zhi, p.z());
+  }
+  for (const V3& p : r.points.positions) {
+    EXPECT_GT(p.z(), zlo - 0.03f);
+    EXPECT_LT(p.z(), zhi + 0.03f);
+  }
+}
+
+TEST(PointTexture, DeterministicWhateverTheThreadCount) {
+  const PointExemplar& ex = bumps_exemplar();
+  PointTextureOptions o = small_options();
+  o.seed = 11;
+  PointTextureResult a, b;
+  {
+    tbb::global_control one(tbb::global_control::max_allowed_parallelism, 1);
+    a = synthesize_points(ex, 1.0, 1.0, o);
+  }
+  {
+    tbb::global_control many(tbb::global_control::max_allowed_parallelism, 8);
+    b = synthesize_points(ex, 1.0, 1.0, o);
+  }
+  ASSERT_EQ(a.points.size(), b.points.size());
+  for (std::size_t i = 0; i < a.points.size(); ++i) {
+    ASSERT_EQ(a.points.positions[i], b.points.positions[i]) << i;
+    ASSERT_EQ(a.points.normals[i], b.points.normals[i]) << i;
+  }
+  o.seed = 12;
+  const PointTextureResult c = synthesize_points(ex, 1.0, 1.0, o);
+  EXPECT_FALSE(c.points.size() == a.points.size() &&
+               std::equal(a.points.positions.begin(), a.points.positions.end(), c.points.positions.begin()));
+}
+
+TEST(PointTexture, BadInputsSayWhatToChange) {
+  const PointExemplar& good = bumps_exemplar();
+  PointExemplar no_normals = good;
+  no_normals.points.normals.clear();
+  EXPECT_THROW(synthesize_points(no_normals, 1, 1, small_options()), InvalidInput);
+  PointExemplar nan = good;
+  nan.points.positions[5].x() = std::nanf("");
+  EXPECT_THROW(synthesize_points(nan, 1, 1, small_options()), InvalidInput);
+  PointExemplar empty;
+  EXPECT_THROW(synthesize_points(empty, 1, 1, small_options()), InvalidInput);
+  PointExemplar off_box = good;
+  off_box.box_min = {5, 5};
+  off_box.box_max = {6, 6};
+  EXPECT_THROW(synthesize_points(off_box, 1, 1, small_options()), InvalidInput);
+  PointTextureOptions big = small_options();
+  big.patch_size = 1.6;
+  try {
+    synthesize_points(good, 1, 1, big);
+    FAIL() << "a patch larger than the exemplar must be refused";
+  } catch (const InvalidInput& e) {
+    EXPECT_NE(std::string(e.what()).find("lower the patch size"), std::string::npos) << e.what();
+  }
+  PointTextureOptions tight = small_options();
+  tight.memory_budget = 1 << 20;
+  EXPECT_THROW(synthesize_points(good, 50, 50, tight), OverBudget);
+  EXPECT_THROW(synthesize_points(good, 0, 1, small_options()), InvalidInput);
+  EXPECT_THROW(make_point_exemplar("moss"), InvalidInput);
+  ExecContext ctx;
+  ctx.cancel();
+  EXPECT_THROW(synthesize_points(good, 1, 1, small_options(), &ctx), Cancelled);
+}
+
+TEST(PointTexture, BuiltInExemplarsHavePaddingAndDensity) {
+  for (const char* name : {"chainmail", "weave", "flowers"}) {
+    const PointExemplar ex = make_point_exemplar(name, 2000.0, 0.3, 0);
+    ASSERT_GT(ex.points.size(), 500u) << name;
+    float xmin = 1e9f, xmax = -1e9f;
+    for (const V3& p : ex.points.positions) {
+      xmin = std::min(xmin, p.x());
+      xmax = std::max(xmax, p.x());
+    }
+    EXPECT_LT(xmin, -0.2f) << name << ": geometry extends past the box (padding)";
+    EXPECT_GT(xmax, 1.2f) << name;
+    EXPECT_NO_THROW(validate_exemplar(ex, name));
+  }
+}
+
+TEST(PointTextureOnMesh, StaysWithinTheTextureHeightAndFollowsTheField) {
+  // Ridges along x (height varies along y) laid on a flat target mesh with
+  // the field along world Y: the ridges must run along Y, so the output's
+  // normals tilt in X, not in Y.
+  const int n = 48;
+  std::vector<float> h(std::size_t(n) * n);
+  for (int r = 0; r < n; ++r)
+    for (int c = 0; c < n; ++c) h[std::size_t(r) * n + c] = float(0.08 * std::sin(2 * 3.14159265 * r / 8.0));
+  const PointExemplar ex = height_field_exemplar(h, n, n, 0.0625, 400.0, 8, 0);  // 2 x 2 box, 0.5 padding
+  TriangleMesh plane;
+  const int m = 8;
+  for (int j = 0; j <= m; ++j)
+    for (int i = 0; i <= m; ++i) plane.vertices.emplace_back(float(i) / m * 3.0f, float(j) / m * 3.0f, 0.0f);
+  for (int j = 0; j < m; ++j)
+    for (int i = 0; i < m; ++i) {
+      const int a = j * (m + 1) + i;
+      plane.faces.emplace_back(a, a + 1, a + m + 2);
+      plane.faces.emplace_back(a, a + m + 2, a + m + 1);
+    }
+  std::vector<V3> field(plane.vertices.size(), V3::UnitY());
+  PointTextureOptions o;
+  o.patch_size = 1.0;
+  o.grid_resolution = 8;
+  const PointTextureResult r = synthesize_points_on_mesh(ex, plane, field, 1.0, o);
+  ASSERT_GT(r.points.size(), 1000u);
+  double nx = 0, ny = 0;
+  for (std::size_t i = 0; i < r.points.size(); ++i) {
+    EXPECT_LT(std::abs(r.points.positions[i].z()), 0.08f + 0.1f);
+    nx += std::abs(r.points.normals[i].x());
+    ny += std::abs(r.points.normals[i].y());
+  }
+  EXPECT_GT(nx, 3.0 * ny) << "ridges should run along the field (Y)";
+  // A curved target: a sphere, points within the texture height of it.
+  const TriangleMesh sphere = exsynth::testing::icosphere(3.0f, 3);
+  std::vector<V3> around(sphere.vertices.size());
+  for (std::size_t i = 0; i < around.size(); ++i) around[i] = V3::UnitZ().cross(sphere.vertices[i]);
+  const PointTextureResult s = synthesize_points_on_mesh(ex, sphere, around, 1.5, o);
+  ASSERT_GT(s.points.size(), 1000u);
+  for (const V3& p : s.points.positions) EXPECT_NEAR(p.norm(), 3.0f, 1.5f * 0.08f + 0.1f);
+}
+
+TEST(PointsToMesh, ASphereComesBackAsItsSurface) {
+  const OrientedPoints sphere = sphere_points(1.0f, 6000);
+  const TriangleMesh m = points_to_mesh(sphere);
+  ASSERT_GT(m.faces.size(), 1000u);
+  for (const V3& v : m.vertices) EXPECT_NEAR(v.norm(), 1.0f, 0.03f);
+  // Counter-clockwise seen from outside: positive enclosed volume, about the ball's.
+  EXPECT_NEAR(enclosed_volume(m), 4.0 / 3.0 * 3.14159265 * 1.0, 0.15);
+  OrientedPoints bad = sphere;
+  bad.normals.pop_back();
+  EXPECT_THROW(points_to_mesh(bad), InvalidInput);
+}
