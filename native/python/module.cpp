@@ -14,6 +14,7 @@ void bind_field(py::module_& m);
 void bind_pairs(py::module_& m);
 void bind_analogy(py::module_& m);
 void bind_frames(py::module_& m);
+void bind_surface(py::module_& m);
 }  // namespace exsynth::py_bind
 
 PYBIND11_MODULE(_native, m) {
@@ -27,4 +28,5 @@ PYBIND11_MODULE(_native, m) {
   exsynth::py_bind::bind_pairs(m);
   exsynth::py_bind::bind_analogy(m);
   exsynth::py_bind::bind_frames(m);
+  exsynth::py_bind::bind_surface(m);
 }

@@ -1,0 +1,277 @@
+// Multiscale synthesis on the surface (Ying et al. 2001, §4; Wei & Levoy
+// 2000): Gaussian pyramids of the exemplar and of every face map, brute force
+// at the coarsest level, then per finer level a pass with coarse-level
+// neighbourhoods only and a pass with current + coarse neighbourhoods.
+//
+// Departure: each pass reads the previous pass's values (Jacobi order, all
+// texels in parallel) instead of the paper's causal scanline order — passes
+// are deterministic whatever the thread count and use both cores; the
+// second pass sees a full 9x9 (non-causal) current-level neighbourhood.
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include <nanoflann.hpp>
+
+#include "exsynth/parallel.hpp"
+#include "exsynth/pyramid.hpp"
+#include "exsynth/rng.hpp"
+#include "search/pca.hpp"
+#include "surface/methods.hpp"
+#include "surface/walk.hpp"
+
+namespace exsynth::surface {
+
+int multiscale_levels(const Image& ex, const TexelGrid& grid, const SurfaceSynthesisOptions& opt) {
+  if (opt.levels > 0) return opt.levels;
+  double mean_res = 0;
+  for (int r : grid.res) mean_res += r;
+  mean_res /= std::max<std::size_t>(grid.res.size(), 1);
+  int levels = 1;
+  const int side = std::min(ex.width(), ex.height());
+  while (levels < 4 && (side >> levels) >= std::max(opt.fine_neighborhood, 8) && mean_res / (1 << levels) >= 1.0)
+    ++levels;
+  return levels;
+}
+
+namespace {
+
+using search::RowMatrixXf;
+
+struct Layout {
+  int fine_r = 0, coarse_r = 0;  // radii; 0 / -1 = unused
+  bool fine = false, coarse = false;
+  std::vector<float> fine_w, coarse_w;  // sqrt of the Gaussian weights
+  int channels = 0;
+  int dims() const {
+    const int nf = fine ? (2 * fine_r + 1) * (2 * fine_r + 1) : 0;
+    const int nc = coarse ? (2 * coarse_r + 1) * (2 * coarse_r + 1) : 0;
+    return (nf + nc) * channels;
+  }
+};
+
+std::vector<float> gaussian_sqrt_weights(int r) {
+  std::vector<float> w;
+  const double sigma = std::max(1.0, r / 1.5);
+  for (int m = -r; m <= r; ++m)
+    for (int l = -r; l <= r; ++l) w.push_back(float(std::exp(-(l * l + m * m) / (4 * sigma * sigma))));
+  return w;
+}
+
+class MultiscaleSolver {
+ public:
+  MultiscaleSolver(const SubdivSurface& s, const TexelFrames& fr, const Image& ex, const SurfaceSynthesisOptions& o,
+                   double h, ExecContext* ctx)
+      : surface_(s), frames_(fr), opt_(o), h_(h), ctx_(ctx), C_(ex.channels()) {
+    levels_ = multiscale_levels(ex, fr.grid, o);
+    PyramidOptions po;
+    po.levels = levels_;
+    po.boundary = o.tileable_exemplar ? Boundary::Wrap : Boundary::Clamp;
+    ex_ = gaussian_pyramid(ex, po, ctx);
+    grids_.push_back(fr.grid);
+    for (int l = 1; l < levels_; ++l) grids_.push_back(grids_.back().coarser());
+    values_.resize(std::size_t(levels_));
+    src_.resize(std::size_t(levels_));
+  }
+
+  void run(SurfaceTexture& out) {
+    const int top = levels_ - 1;
+    init_random(top);
+    for (int pass = 0; pass < 2; ++pass) run_pass(top, layout(Pass::Coarsest), true, 100 + std::uint64_t(pass));
+    for (int l = top - 1; l >= 0; --l) {
+      run_pass(l, layout(Pass::CoarseOnly), false, 4 * std::uint64_t(l));
+      run_pass(l, layout(Pass::Full), false, 4 * std::uint64_t(l) + 1);
+    }
+    out.texels = values_[0];
+    const std::size_t n = grids_[0].size();
+    out.source.resize(n * 2);
+    const int w = ex_[0].width();
+    for (std::size_t t = 0; t < n; ++t) {
+      out.source[t * 2] = float(src_[0][t] % w);
+      out.source[t * 2 + 1] = float(src_[0][t] / w);
+    }
+  }
+
+ private:
+  enum class Pass { Coarsest, CoarseOnly, Full };
+
+  /// Coarsest level: current-level neighbourhood only (brute force). Finer
+  /// levels: pass 1 coarse-level only, pass 2 current + coarse.
+  Layout layout(Pass pass) const {
+    Layout lay;
+    lay.channels = C_;
+    lay.fine = pass != Pass::CoarseOnly;
+    lay.coarse = pass != Pass::Coarsest;
+    lay.fine_r = opt_.fine_neighborhood / 2;
+    lay.coarse_r = opt_.coarse_neighborhood / 2;
+    lay.fine_w = gaussian_sqrt_weights(lay.fine_r);
+    lay.coarse_w = gaussian_sqrt_weights(lay.coarse_r);
+    return lay;
+  }
+
+  double spacing(int level) const { return h_ * double(1 << level); }
+
+  void set_texel(int l, std::size_t t, int pixel) {
+    src_[std::size_t(l)][t] = pixel;
+    const Image& e = ex_[std::size_t(l)];
+    const float* p = e.data() + std::size_t(pixel) * std::size_t(C_);
+    std::copy(p, p + C_, values_[std::size_t(l)].begin() + std::ptrdiff_t(t * std::size_t(C_)));
+  }
+
+  void init_random(int l) {
+    const std::size_t n = grids_[std::size_t(l)].size();
+    values_[std::size_t(l)].assign(n * std::size_t(C_), 0.0f);
+    src_[std::size_t(l)].assign(n, 0);
+    const Image& e = ex_[std::size_t(l)];
+    for (std::size_t t = 0; t < n; ++t) {
+      IndexRng rng(opt_.seed, t, 1000 + std::uint64_t(l));
+      set_texel(l, t, int(rng.below(std::uint64_t(e.width()) * std::uint64_t(e.height()))));
+    }
+  }
+
+  void exemplar_feature(int l, int x, int y, const Layout& lay, float* out) const {
+    const bool wrap = opt_.tileable_exemplar;
+    float* o = out;
+    if (lay.fine) {
+      const Image& e = ex_[std::size_t(l)];
+      int k = 0;
+      for (int m = -lay.fine_r; m <= lay.fine_r; ++m)
+        for (int i = -lay.fine_r; i <= lay.fine_r; ++i, ++k) {
+          sample_exemplar(e, x + i, y + m, wrap, o);
+          for (int c = 0; c < C_; ++c) o[c] *= lay.fine_w[std::size_t(k)];
+          o += C_;
+        }
+    }
+    if (lay.coarse) {
+      const Image& e = ex_[std::size_t(l + 1)];
+      int k = 0;
+      for (int m = -lay.coarse_r; m <= lay.coarse_r; ++m)
+        for (int i = -lay.coarse_r; i <= lay.coarse_r; ++i, ++k) {
+          sample_exemplar(e, 0.5 * x + i, 0.5 * y + m, wrap, o);
+          for (int c = 0; c < C_; ++c) o[c] *= lay.coarse_w[std::size_t(k)];
+          o += C_;
+        }
+    }
+  }
+
+  /// Walks the sample grid of radius r at spacing hh around p and copies the
+  /// values of the level-`lv` texels the samples land in.
+  void gather(const SurfacePoint& p, std::size_t t0, int lv, int r, double hh, const std::vector<float>& w,
+              float*& o) const {
+    const Eigen::Vector3d a = frames_.t1[t0].cast<double>() * hh, b = frames_.t2[t0].cast<double>() * hh;
+    const TexelGrid& g = grids_[std::size_t(lv)];
+    const std::vector<float>& vals = values_[std::size_t(lv)];
+    int k = 0;
+    for (int m = -r; m <= r; ++m)
+      for (int l = -r; l <= r; ++l, ++k) {
+        SurfacePoint q = p;
+        if (l || m) walk_cached(surface_, frames_, q, double(l) * a - double(m) * b);
+        const float* v = vals.data() + g.texel(q) * std::size_t(C_);
+        for (int c = 0; c < C_; ++c) o[c] = v[c] * w[std::size_t(k)];
+        o += C_;
+      }
+  }
+
+  void target_feature(int l, std::size_t t, const Layout& lay, float* out) const {
+    const SurfacePoint p = grids_[std::size_t(l)].centre(t);
+    const std::size_t t0 = frames_.grid.texel(p);
+    float* o = out;
+    if (lay.fine) gather(p, t0, l, lay.fine_r, spacing(l), lay.fine_w, o);
+    if (lay.coarse) gather(p, t0, l + 1, lay.coarse_r, spacing(l + 1), lay.coarse_w, o);
+  }
+
+  /// Among k (distance, pixel) pairs sorted by distance: a random one within
+  /// (1 + tolerance) of the best.
+  int pick(std::vector<std::pair<float, int>>& best, std::size_t t, std::uint64_t stream) const {
+    std::sort(best.begin(), best.end());
+    const float limit = best[0].first * float(1.0 + opt_.knn_tolerance);
+    std::size_t n = 1;
+    while (n < best.size() && best[n].first <= limit) ++n;
+    IndexRng rng(opt_.seed, t, stream);
+    return best[std::size_t(rng.below(n))].second;
+  }
+
+  void run_pass(int l, const Layout& lay, bool brute_force, std::uint64_t stream) {
+    const Image& e = ex_[std::size_t(l)];
+    const int D = lay.dims();
+    const int P = e.width() * e.height();
+    RowMatrixXf X(P, D);
+    for (int y = 0; y < e.height(); ++y)
+      for (int x = 0; x < e.width(); ++x) exemplar_feature(l, x, y, lay, X.row(y * e.width() + x).data());
+
+    const std::size_t n = grids_[std::size_t(l)].size();
+    std::vector<float> next_values(n * std::size_t(C_));
+    std::vector<int> next_src(n);
+    if (values_[std::size_t(l)].empty()) {
+      values_[std::size_t(l)].assign(n * std::size_t(C_), 0.0f);
+      src_[std::size_t(l)].assign(n, 0);
+    }
+    const int k = std::min(opt_.knn, P);
+    StageProgress progress(ctx_, "multiscale level " + std::to_string(l) + (lay.fine ? (lay.coarse ? " pass 2" : " coarsest") : " pass 1"),
+                           0.0, 1.0, n);
+    auto store = [&](std::size_t t, int pixel) {
+      next_src[t] = pixel;
+      const float* p = e.data() + std::size_t(pixel) * std::size_t(C_);
+      std::copy(p, p + C_, next_values.begin() + std::ptrdiff_t(t * std::size_t(C_)));
+    };
+    if (brute_force) {
+      parallel_chunks(n, 256, progress, [&](std::size_t b, std::size_t end) {
+        std::vector<float> q(static_cast<std::size_t>(D));
+        std::vector<std::pair<float, int>> all(static_cast<std::size_t>(P));
+        for (std::size_t t = b; t < end; ++t) {
+          target_feature(l, t, lay, q.data());
+          const Eigen::Map<const Eigen::RowVectorXf> qv(q.data(), D);
+          for (int i = 0; i < P; ++i) all[std::size_t(i)] = {(X.row(i) - qv).norm(), i};
+          std::partial_sort(all.begin(), all.begin() + k, all.end());
+          std::vector<std::pair<float, int>> best(all.begin(), all.begin() + k);
+          store(t, pick(best, t, stream));
+        }
+      });
+    } else {
+      const search::Pca pca = search::fit_pca(X, opt_.pca_variance, opt_.max_pca_dims);
+      const RowMatrixXf Y = pca.project(X);
+      using Tree = nanoflann::KDTreeEigenMatrixAdaptor<RowMatrixXf, -1, nanoflann::metric_L2_Simple>;
+      Tree tree(int(Y.cols()), std::cref(Y), 16);
+      tree.index->buildIndex();
+      parallel_chunks(n, 256, progress, [&](std::size_t b, std::size_t end) {
+        RowMatrixXf q(1, D);
+        std::vector<Eigen::Index> idx(static_cast<std::size_t>(k));
+        std::vector<float> d2(static_cast<std::size_t>(k));
+        for (std::size_t t = b; t < end; ++t) {
+          target_feature(l, t, lay, q.data());
+          const RowMatrixXf qp = pca.project(q);
+          nanoflann::KNNResultSet<float, Eigen::Index> result(static_cast<std::size_t>(k));
+          result.init(idx.data(), d2.data());
+          tree.index->findNeighbors(result, qp.data(), nanoflann::SearchParams(32, 0.0f));
+          std::vector<std::pair<float, int>> best;
+          for (std::size_t i = 0; i < result.size(); ++i) best.push_back({std::sqrt(d2[i]), int(idx[i])});
+          store(t, pick(best, t, stream));
+        }
+      });
+    }
+    values_[std::size_t(l)].swap(next_values);
+    src_[std::size_t(l)].swap(next_src);
+  }
+
+  const SubdivSurface& surface_;
+  const TexelFrames& frames_;
+  const SurfaceSynthesisOptions& opt_;
+  double h_;
+  ExecContext* ctx_;
+  int C_;
+  int levels_ = 1;
+  std::vector<Image> ex_;
+  std::vector<TexelGrid> grids_;
+  std::vector<std::vector<float>> values_;
+  std::vector<std::vector<int>> src_;
+};
+
+}  // namespace
+
+void run_multiscale(const SubdivSurface& surface, const TexelFrames& frames, const Image& exemplar,
+                    const SurfaceSynthesisOptions& opt, SurfaceTexture& out, ExecContext* ctx) {
+  MultiscaleSolver solver(surface, frames, exemplar, opt, out.sample_spacing, ctx);
+  solver.run(out);
+}
+
+}  // namespace exsynth::surface
