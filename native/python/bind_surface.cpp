@@ -27,11 +27,14 @@ PolygonMesh to_polygon_mesh(const py::array& vertices, const py::array& face_siz
       throw InvalidInput(std::string(a == &face_sizes ? "'face_sizes'" : "'face_vertices'") +
                          " must be an integer array, got " + describe(*a));
   PolygonMesh m;
-  auto v = py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(vertices).unchecked<2>();
+  const auto v_arr = py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(vertices);
+  auto v = v_arr.unchecked<2>();
   m.vertices.resize(std::size_t(v.shape(0)));
   for (py::ssize_t i = 0; i < v.shape(0); ++i) m.vertices[std::size_t(i)] = Eigen::Vector3f(float(v(i, 0)), float(v(i, 1)), float(v(i, 2)));
-  auto fs = py::array_t<long long, py::array::c_style | py::array::forcecast>::ensure(face_sizes).unchecked<1>();
-  auto fv = py::array_t<long long, py::array::c_style | py::array::forcecast>::ensure(face_vertices).unchecked<1>();
+  const auto fs_arr = py::array_t<long long, py::array::c_style | py::array::forcecast>::ensure(face_sizes);
+  auto fs = fs_arr.unchecked<1>();
+  const auto fv_arr = py::array_t<long long, py::array::c_style | py::array::forcecast>::ensure(face_vertices);
+  auto fv = fv_arr.unchecked<1>();
   for (py::ssize_t i = 0; i < fs.shape(0); ++i) {
     if (fs(i) < 0 || fs(i) > 1 << 20) throw InvalidInput("face_sizes[" + std::to_string(i) + "] is out of range");
     m.face_sizes.push_back(int(fs(i)));
@@ -70,7 +73,8 @@ Image to_exemplar(const py::array& a) {
 
 std::vector<Eigen::Vector3f> to_field(const py::array& a, std::size_t vertices) {
   check_shape(a, "field", {py::ssize_t(vertices), 3}, "(V, 3) float, one vector per control vertex");
-  auto d = py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(a).unchecked<2>();
+  const auto d_arr = py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(a);
+  auto d = d_arr.unchecked<2>();
   std::vector<Eigen::Vector3f> out(vertices);
   for (py::ssize_t i = 0; i < d.shape(0); ++i) {
     out[std::size_t(i)] = Eigen::Vector3f(float(d(i, 0)), float(d(i, 1)), float(d(i, 2)));
@@ -195,8 +199,10 @@ Returns {'atlas': (H, W, C) float32 (row 0 = top), 'vertices': (N, 3), 'normals'
         const PolygonMesh mesh = to_polygon_mesh(vertices, face_sizes, face_vertices);
         check_shape(faces, "faces", {-1}, "(N,) int ptex face indices");
         check_shape(uv, "uv", {faces.shape(0), 2}, "(N, 2) float in [0, 1]");
-        auto f = py::array_t<long long, py::array::c_style | py::array::forcecast>::ensure(faces).unchecked<1>();
-        auto u = py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(uv).unchecked<2>();
+        const auto f_arr = py::array_t<long long, py::array::c_style | py::array::forcecast>::ensure(faces);
+  auto f = f_arr.unchecked<1>();
+        const auto u_arr = py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(uv);
+  auto u = u_arr.unchecked<2>();
         std::vector<double> pos(std::size_t(f.shape(0)) * 3), du(pos.size()), dv(pos.size());
         {
           py::gil_scoped_release release;

@@ -240,7 +240,7 @@ TEST(SurfaceWalk, AroundExtraordinaryVerticesOnAFlatDiscWalksStayStraight) {
       const V3d d = 0.9 * V3d(std::cos(a), std::sin(a), 0);
       SurfacePoint p{f, 0.3, 0.4};
       ASSERT_TRUE(s.walk(p, d));
-      EXPECT_NEAR((s.evaluate(p).position - (c.position + d)).norm(), 0.0, 1e-6);
+      EXPECT_NEAR((s.evaluate(p).position - (c.position + d)).norm(), 0.0, 1e-6) << "face " << f << " dir " << k;
       ++checked;
     }
   }

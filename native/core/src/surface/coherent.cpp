@@ -7,6 +7,7 @@
 #include <deque>
 #include <limits>
 
+#include "exsynth/parallel.hpp"
 #include "exsynth/rng.hpp"
 #include "surface/methods.hpp"
 #include "surface/walk.hpp"
@@ -52,55 +53,69 @@ std::vector<std::size_t> synthesis_order(const SubdivSurface& surface, const Tex
 
 namespace {
 
-struct Neighbourhood {
-  std::vector<SurfacePoint> points;
-  std::vector<char> valid;
-  std::vector<std::size_t> texel;
-  std::vector<Eigen::Vector2d> offset;  // tangent-plane offset of the texel centre, in exemplar pixels
+/// Per texel, its (2r+1)^2 - 1 neighbours (the centre left out): the texel
+/// each sample lands in (-1 past a boundary) and that texel's offset in
+/// exemplar pixels, corrected by the first-order vector from the landing
+/// point to the texel's centre projected on (v1, -v2). Built in parallel
+/// before the (sequential) synthesis.
+struct NeighbourTable {
+  int per = 0;
+  std::vector<std::int32_t> texel;
+  std::vector<Eigen::Vector2f> offset;
 };
 
-/// Samples around texel t; each sample snaps to the texel it lands in, and
-/// its offset is corrected by the (first-order) vector from the landing
-/// point to that texel's centre, projected on (v1, -v2).
-void gather(const SubdivSurface& surface, const TexelFrames& fr, std::size_t t, double h, int r, Neighbourhood& nb) {
+NeighbourTable neighbour_table(const SubdivSurface& surface, const TexelFrames& fr, double h, int r, ExecContext* ctx) {
   const int n = (2 * r + 1) * (2 * r + 1);
-  bool valid[128];
-  sample_points(surface, fr, t, h, r, nb.points.data(), valid);
-  const Eigen::Vector3d a = fr.t1[t].cast<double>(), b = fr.t2[t].cast<double>();
-  for (int k = 0; k < n; ++k) {
-    nb.valid[std::size_t(k)] = valid[k];
-    if (!valid[k]) continue;
-    const SurfacePoint& p = nb.points[std::size_t(k)];
-    const std::size_t q = fr.grid.texel(p);
-    const SurfacePoint c = fr.grid.centre(q);
-    const Eigen::Vector3d to_centre = fr.du[q].cast<double>() * (c.u - p.u) + fr.dv[q].cast<double>() * (c.v - p.v);
-    const int l = k % (2 * r + 1) - r, m = k / (2 * r + 1) - r;
-    nb.texel[std::size_t(k)] = q;
-    nb.offset[std::size_t(k)] = Eigen::Vector2d(l + to_centre.dot(a) / h, m - to_centre.dot(b) / h);
-  }
+  NeighbourTable tab;
+  tab.per = n - 1;
+  const std::size_t count = fr.grid.size();
+  tab.texel.resize(count * std::size_t(tab.per));
+  tab.offset.resize(count * std::size_t(tab.per));
+  StageProgress progress(ctx, "surface neighbourhoods", 0.0, 1.0, count);
+  parallel_chunks(count, 1024, progress, [&](std::size_t b, std::size_t e) {
+    SurfacePoint pts[121];
+    bool valid[121];
+    for (std::size_t t = b; t < e; ++t) {
+      sample_points(surface, fr, t, h, r, pts, valid);
+      const Eigen::Vector3d a = fr.t1[t].cast<double>(), bb = fr.t2[t].cast<double>();
+      std::size_t at = t * std::size_t(tab.per);
+      for (int k = 0; k < n; ++k) {
+        const int l = k % (2 * r + 1) - r, m = k / (2 * r + 1) - r;
+        if (l == 0 && m == 0) continue;
+        if (!valid[k]) {
+          tab.texel[at++] = -1;
+          continue;
+        }
+        const SurfacePoint& p = pts[k];
+        const std::size_t q = fr.grid.texel(p);
+        const SurfacePoint c = fr.grid.centre(q);
+        const Eigen::Vector3d to_centre =
+            fr.du[q].cast<double>() * (c.u - p.u) + fr.dv[q].cast<double>() * (c.v - p.v);
+        tab.texel[at] = std::int32_t(q);
+        tab.offset[at++] = Eigen::Vector2f(float(l + to_centre.dot(a) / h), float(m - to_centre.dot(bb) / h));
+      }
+    }
+  });
+  return tab;
 }
 
 }  // namespace
 
 void run_coherent(const SubdivSurface& surface, const TexelFrames& fr, const Image& ex,
                   const SurfaceSynthesisOptions& opt, SurfaceTexture& out, ExecContext* ctx) {
-  const int r = opt.coherent_radius;
-  const int n = (2 * r + 1) * (2 * r + 1);
   const int C = ex.channels();
   const double h = out.sample_spacing;
   const bool wrap = opt.tileable_exemplar;
   const std::size_t count = fr.grid.size();
+  const NeighbourTable tab = neighbour_table(surface, fr, h, opt.coherent_radius, ctx);
+  const int per = tab.per;
   const std::vector<std::size_t> order = synthesis_order(surface, fr.grid);
   std::vector<char> done(count, 0);
   out.texels.assign(count * std::size_t(C), 0.0f);
   out.source.assign(count * 2, 0.0f);
 
-  Neighbourhood nb;
-  nb.points.resize(std::size_t(n));
-  nb.valid.resize(std::size_t(n));
-  nb.texel.resize(std::size_t(n));
-  nb.offset.resize(std::size_t(n));
   std::vector<Eigen::Vector2d> cands;
+  std::vector<int> known;  // neighbour slots already synthesized
   std::vector<float> value(static_cast<std::size_t>(C));
   const double W = ex.width(), H = ex.height();
   auto inside = [&](Eigen::Vector2d& c) {
@@ -116,18 +131,20 @@ void run_coherent(const SubdivSurface& surface, const TexelFrames& fr, const Ima
 
   StageProgress progress(ctx, "coherent synthesis", 0.0, 1.0, count);
   for (std::size_t k = 0; k < count; ++k) {
-    if ((k & 2047) == 0) {
+    if ((k & 4095) == 0) {
       progress.check();
-      if (k) progress.advance(2048);
+      if (k) progress.advance(4096);
     }
     const std::size_t t = order[k];
-    gather(surface, fr, t, h, r, nb);
+    const std::int32_t* nb = tab.texel.data() + t * std::size_t(per);
+    const Eigen::Vector2f* off = tab.offset.data() + t * std::size_t(per);
+    known.clear();
     cands.clear();
-    for (int s = 0; s < n; ++s) {
-      if (!nb.valid[std::size_t(s)] || !done[nb.texel[std::size_t(s)]]) continue;
-      const std::size_t q = nb.texel[std::size_t(s)];
-      Eigen::Vector2d c(out.source[q * 2] - nb.offset[std::size_t(s)].x(),
-                        out.source[q * 2 + 1] - nb.offset[std::size_t(s)].y());
+    for (int s = 0; s < per; ++s) {
+      if (nb[s] < 0 || std::size_t(nb[s]) == t || !done[std::size_t(nb[s])]) continue;
+      known.push_back(s);
+      const std::size_t q = std::size_t(nb[s]);
+      Eigen::Vector2d c(out.source[q * 2] - off[s].x(), out.source[q * 2 + 1] - off[s].y());
       if (!inside(c)) continue;
       bool seen = false;
       for (const auto& o : cands) seen = seen || (o - c).squaredNorm() < 0.0625;
@@ -141,13 +158,10 @@ void run_coherent(const SubdivSurface& surface, const TexelFrames& fr, const Ima
       double best_d = std::numeric_limits<double>::infinity();
       for (const auto& c : cands) {
         double d = 0;
-        for (int s = 0; s < n && d < best_d; ++s) {
-          if (!nb.valid[std::size_t(s)]) continue;
-          const std::size_t q = nb.texel[std::size_t(s)];
-          if (!done[q] || q == t) continue;
-          sample_exemplar(ex, c.x() + nb.offset[std::size_t(s)].x(), c.y() + nb.offset[std::size_t(s)].y(), wrap,
-                          value.data());
-          const float* tq = out.texels.data() + q * std::size_t(C);
+        for (std::size_t i = 0; i < known.size() && d < best_d; ++i) {
+          const int s = known[i];
+          sample_exemplar(ex, c.x() + off[s].x(), c.y() + off[s].y(), wrap, value.data());
+          const float* tq = out.texels.data() + std::size_t(nb[s]) * std::size_t(C);
           for (int ch = 0; ch < C; ++ch) d += double(value[std::size_t(ch)] - tq[ch]) * (value[std::size_t(ch)] - tq[ch]);
         }
         if (d < best_d) {

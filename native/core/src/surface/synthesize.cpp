@@ -37,6 +37,8 @@ double bytes_per_texel(const SurfaceSynthesisOptions& o, int channels) {
   // frames (5 float3) + texels + sources + order/flags; multiscale adds its
   // pyramid of values and the feature row being built per thread.
   double b = 5 * 12 + 4.0 * channels + 8 + 9;
+  if (o.method == SurfaceMethod::Coherent)  // the neighbour table
+    b += 12.0 * ((2 * o.coherent_radius + 1) * (2 * o.coherent_radius + 1) - 1);
   if (o.method == SurfaceMethod::Multiscale) b += (4.0 * channels + 4) * 4.0 / 3.0 + 8;
   return b;
 }

@@ -82,10 +82,14 @@ TexelFrames build_texel_frames(const SubdivSurface& surface, TexelGrid grid,
   return fr;
 }
 
+// The cache is linear per texel (no need for short steps) and only
+// piecewise smooth (loose tolerance, few corrections, slide along edges).
+constexpr WalkParams kCachedWalk{1e-3, 1.0, 3, true};
+
 bool walk_cached(const SubdivSurface& surface, const TexelFrames& frames, SurfacePoint& p,
                  const Eigen::Vector3d& d) {
   return walk_surface([&](const SurfacePoint& q) { return frames.approx(q); },
-                      [&](int f, int e, double t) { return surface.cross_edge(f, e, t); }, p, d);
+                      [&](int f, int e, double t) { return surface.cross_edge(f, e, t); }, p, d, kCachedWalk);
 }
 
 void sample_points(const SubdivSurface& surface, const TexelFrames& frames, std::size_t t, double h, int r,

@@ -36,13 +36,29 @@ constexpr double kMaxParamStep = 0.25;
 
 /// See SubdivSurface::walk. `eval(p)` returns a LimitFrame; `cross(f, e, t)`
 /// a SubdivSurface::EdgeCrossing.
+struct WalkParams {
+  double rel_tol = 1e-9;              ///< stop when the rest is below rel_tol |d|
+  double max_step = kMaxParamStep;    ///< largest parameter step per iteration
+  int max_corrections = 32;           ///< see below
+  /// Slide along an edge just crossed instead of crossing it back: the
+  /// cache's frames differ slightly on the two sides of an edge, so a walk
+  /// nearly along it would bounce between the faces. (Exact frames agree.)
+  bool slide = false;
+};
+
 template <class Eval, class Crossing>
-bool walk_surface(Eval&& eval, Crossing&& cross, SurfacePoint& p, Eigen::Vector3d d) {
+bool walk_surface(Eval&& eval, Crossing&& cross, SurfacePoint& p, Eigen::Vector3d d, const WalkParams& wp = {}) {
   const double len0 = d.norm();
   if (!(len0 > 0)) return true;
-  const double tol = 1e-9 * len0;
+  // Converged when the rest is below tol, or after a few corrections (steps
+  // with less than 1 % of the walk left, or following a whole in-face step):
+  // the texel cache is only piecewise smooth, so near a face edge its
+  // residual need not fall below tol and would bounce between the faces.
+  const double tol = wp.rel_tol * len0;
+  int corrections = 0, stalled = 0;
+  int entry = -1;  // the edge p sits on after a crossing: do not bounce back through it
   LimitFrame f = eval(p);
-  for (int it = 0; it < 96; ++it) {
+  for (int it = 0; it < 96 && corrections < wp.max_corrections; ++it) {
     Eigen::Vector3d n = f.du.cross(f.dv);
     const double nn = n.norm();
     if (!(nn > 0)) return true;
@@ -60,9 +76,18 @@ bool walk_surface(Eval&& eval, Crossing&& cross, SurfacePoint& p, Eigen::Vector3
     const double r0 = f.du.dot(dt), r1 = f.dv.dot(dt);
     double x0 = (c * r0 - b * r1) / det, x1 = (a * r1 - b * r0) / det;
     const double m = std::max(std::abs(x0), std::abs(x1));
-    if (m > kMaxParamStep) {
-      x0 *= kMaxParamStep / m;
-      x1 *= kMaxParamStep / m;
+    if (wp.slide && entry >= 0) {
+      // Inward component across the entry edge (e0: +v, e1: -u, e2: -v, e3: +u);
+      // an outward one would only re-cross: slide along the edge instead.
+      double& w = (entry == 0 || entry == 2) ? x1 : x0;
+      const double inward = (entry == 0 || entry == 3) ? w : -w;
+      if (inward < 0) w = 0;
+    }
+    bool whole = true;
+    if (m > wp.max_step) {
+      x0 *= wp.max_step / m;
+      x1 *= wp.max_step / m;
+      whole = false;
     }
     double lam = 1.0;
     int exit = -1;
@@ -73,6 +98,7 @@ bool walk_surface(Eval&& eval, Crossing&& cross, SurfacePoint& p, Eigen::Vector3
     if (x0 < 0) consider(-p.u / x0, 3);
     if (x1 > 0) consider((1 - p.v) / x1, 2);
     if (x1 < 0) consider(-p.v / x1, 0);
+    if (lam <= 0 && ++stalled > 8) return true;  // circling a vertex the cache cannot resolve
     SurfacePoint q{p.face, std::clamp(p.u + lam * x0, 0.0, 1.0), std::clamp(p.v + lam * x1, 0.0, 1.0)};
     bool inside = true;
     if (exit >= 0) {
@@ -85,8 +111,14 @@ bool walk_surface(Eval&& eval, Crossing&& cross, SurfacePoint& p, Eigen::Vector3
         double u2, v2;
         from_edge(nb.edge, nb.t, 0, u2, v2);
         q = SurfacePoint{nb.face, std::clamp(u2, 0.0, 1.0), std::clamp(v2, 0.0, 1.0)};
+        entry = nb.edge;
       }
+    } else if (entry >= 0) {
+      double t, s;
+      to_edge(entry, q.u, q.v, t, s);
+      if (s > 1e-12) entry = -1;  // left the edge
     }
+    if ((exit < 0 && whole) || len < 1e-2 * len0) ++corrections;
     const LimitFrame g = eval(q);
     d = dt - (g.position - f.position);
     p = q;
