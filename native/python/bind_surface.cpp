@@ -98,6 +98,7 @@ void set_options(SurfaceSynthesisOptions& o, SurfaceOutputOptions& out, const py
     else if (k == "max_face_resolution") o.max_face_resolution = v.cast<int>();
     else if (k == "exemplar_scale") o.exemplar_scale = v.cast<double>();
     else if (k == "coherent_radius") o.coherent_radius = v.cast<int>();
+    else if (k == "coherent_passes") o.coherent_passes = v.cast<int>();
     else if (k == "levels") o.levels = v.cast<int>();
     else if (k == "fine_neighborhood") o.fine_neighborhood = v.cast<int>();
     else if (k == "coarse_neighborhood") o.coarse_neighborhood = v.cast<int>();
@@ -124,7 +125,7 @@ void set_options(SurfaceSynthesisOptions& o, SurfaceOutputOptions& out, const py
     else
       throw InvalidInput("unknown option '" + k +
                          "'; options: method, texels_per_unit, face_resolution, min_face_resolution, "
-                         "max_face_resolution, exemplar_scale, coherent_radius, levels, fine_neighborhood, "
+                         "max_face_resolution, exemplar_scale, coherent_radius, coherent_passes, levels, fine_neighborhood, "
                          "coarse_neighborhood, knn, knn_tolerance, pca_variance, max_pca_dims, tileable_exemplar, "
                          "field_axis, memory_budget, seed, gutter, segments, displacement_channel, "
                          "displacement_scale, displacement_midlevel");
@@ -184,7 +185,7 @@ synthesized together (colour, alpha, height). field (V, 3): tangent vector per v
 exsynth_field or a preset); None = a smooth field from field_axis.
 Options (keywords): method='coherent'|'multiscale', texels_per_unit=0 (0 = face_resolution),
 face_resolution=16, min_face_resolution=2, max_face_resolution=512, exemplar_scale=1,
-coherent_radius=2, levels=0 (auto), fine_neighborhood=9, coarse_neighborhood=5, knn=8,
+coherent_radius=2, coherent_passes=2, levels=0 (auto), fine_neighborhood=9, coarse_neighborhood=5, knn=8,
 knn_tolerance=0.1, pca_variance=0.97, max_pca_dims=24, tileable_exemplar=False,
 field_axis=(0, 0, 1), memory_budget=0 (default), seed=0; output: gutter=2, segments=2 (per n-gon
 sub-face; quads get 2x), displacement_channel=-1, displacement_scale=0, displacement_midlevel=0.5.

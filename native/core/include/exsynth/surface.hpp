@@ -137,6 +137,10 @@ struct SurfaceSynthesisOptions {
   double exemplar_scale = 1.0;
   /// Coherent: neighbourhood radius in samples (2 = 5 x 5, the paper's).
   int coherent_radius = 2;
+  /// Coherent: passes in synthesis order; passes after the first see every
+  /// neighbour (not only the causal ones) and keep a texel's source unless a
+  /// candidate matches better.
+  int coherent_passes = 2;
   /// Multiscale: pyramid levels (0 = as many as the exemplar and faces allow,
   /// at most 4), neighbourhood sizes of the current and the coarser level.
   int levels = 0;

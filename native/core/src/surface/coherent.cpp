@@ -53,6 +53,23 @@ std::vector<std::size_t> synthesis_order(const SubdivSurface& surface, const Tex
 
 namespace {
 
+/// The exemplar pixel nearest to float (x, y): texels copy pixels, never
+/// blends of them (bilinear lookups of the drifting float coordinates blurred
+/// the result: window distance 0.74 vs 0.28 for the 2D synthesis on a flat grid).
+void nearest_exemplar(const Image& ex, double x, double y, bool wrap, float* out) {
+  const int w = ex.width(), h = ex.height();
+  int xi = int(std::floor(x + 0.5)), yi = int(std::floor(y + 0.5));
+  if (wrap) {
+    xi = ((xi % w) + w) % w;
+    yi = ((yi % h) + h) % h;
+  } else {
+    xi = std::clamp(xi, 0, w - 1);
+    yi = std::clamp(yi, 0, h - 1);
+  }
+  const float* p = ex.data() + ex.offset(xi, yi);
+  std::copy(p, p + ex.channels(), out);
+}
+
 /// Per texel, its (2r+1)^2 - 1 neighbours (the centre left out): the texel
 /// each sample lands in (-1 past a boundary) and that texel's offset in
 /// exemplar pixels, corrected by the first-order vector from the landing
@@ -129,19 +146,21 @@ void run_coherent(const SubdivSurface& surface, const TexelFrames& fr, const Ima
     return c.x() >= 0 && c.y() >= 0 && c.x() <= W - 1 && c.y() <= H - 1;
   };
 
-  StageProgress progress(ctx, "coherent synthesis", 0.0, 1.0, count);
-  for (std::size_t k = 0; k < count; ++k) {
+  const int passes = std::max(1, opt.coherent_passes);
+  StageProgress progress(ctx, "coherent synthesis", 0.0, 1.0, count * std::size_t(passes));
+  for (std::size_t k = 0; k < count * std::size_t(passes); ++k) {
     if ((k & 4095) == 0) {
       progress.check();
       if (k) progress.advance(4096);
     }
-    const std::size_t t = order[k];
+    const std::size_t t = order[k % count];
     const std::int32_t* nb = tab.texel.data() + t * std::size_t(per);
     const Eigen::Vector2f* off = tab.offset.data() + t * std::size_t(per);
     known.clear();
     cands.clear();
     for (int s = 0; s < per; ++s) {
       if (nb[s] < 0 || std::size_t(nb[s]) == t || !done[std::size_t(nb[s])]) continue;
+      // Later passes: every neighbour is known; the texel's own source competes too.
       known.push_back(s);
       const std::size_t q = std::size_t(nb[s]);
       Eigen::Vector2d c(out.source[q * 2] - off[s].x(), out.source[q * 2 + 1] - off[s].y());
@@ -150,17 +169,18 @@ void run_coherent(const SubdivSurface& surface, const TexelFrames& fr, const Ima
       for (const auto& o : cands) seen = seen || (o - c).squaredNorm() < 0.0625;
       if (!seen) cands.push_back(c);
     }
+    if (done[t]) cands.emplace_back(out.source[t * 2], out.source[t * 2 + 1]);
     Eigen::Vector2d best;
     if (cands.empty()) {
       IndexRng rng(opt.seed, t);
-      best = Eigen::Vector2d(rng.uniform() * (W - 1), rng.uniform() * (H - 1));
+      best = Eigen::Vector2d(double(rng.below(std::uint64_t(W))), double(rng.below(std::uint64_t(H))));
     } else {
       double best_d = std::numeric_limits<double>::infinity();
       for (const auto& c : cands) {
         double d = 0;
         for (std::size_t i = 0; i < known.size() && d < best_d; ++i) {
           const int s = known[i];
-          sample_exemplar(ex, c.x() + off[s].x(), c.y() + off[s].y(), wrap, value.data());
+          nearest_exemplar(ex, c.x() + off[s].x(), c.y() + off[s].y(), wrap, value.data());
           const float* tq = out.texels.data() + std::size_t(nb[s]) * std::size_t(C);
           for (int ch = 0; ch < C; ++ch) d += double(value[std::size_t(ch)] - tq[ch]) * (value[std::size_t(ch)] - tq[ch]);
         }
@@ -170,7 +190,7 @@ void run_coherent(const SubdivSurface& surface, const TexelFrames& fr, const Ima
         }
       }
     }
-    sample_exemplar(ex, best.x(), best.y(), wrap, out.texels.data() + t * std::size_t(C));
+    nearest_exemplar(ex, best.x(), best.y(), wrap, out.texels.data() + t * std::size_t(C));
     out.source[t * 2] = float(best.x());
     out.source[t * 2 + 1] = float(best.y());
     done[t] = 1;

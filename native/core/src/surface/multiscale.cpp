@@ -81,6 +81,7 @@ class MultiscaleSolver {
     for (int l = top - 1; l >= 0; --l) {
       run_pass(l, layout(Pass::CoarseOnly), false, 4 * std::uint64_t(l));
       run_pass(l, layout(Pass::Full), false, 4 * std::uint64_t(l) + 1);
+      run_pass(l, layout(Pass::Full), false, 4 * std::uint64_t(l) + 2);
     }
     out.texels = values_[0];
     const std::size_t n = grids_[0].size();
@@ -157,7 +158,7 @@ class MultiscaleSolver {
   /// Walks the sample grid of radius r at spacing hh around p and copies the
   /// values of the level-`lv` texels the samples land in.
   void gather(const SurfacePoint& p, std::size_t t0, int lv, int r, double hh, const std::vector<float>& w,
-              float*& o) const {
+              float*& o, const std::vector<char>* visited = nullptr) const {
     const Eigen::Vector3d a = frames_.t1[t0].cast<double>() * hh, b = frames_.t2[t0].cast<double>() * hh;
     const TexelGrid& g = grids_[std::size_t(lv)];
     const std::vector<float>& vals = values_[std::size_t(lv)];
@@ -166,17 +167,21 @@ class MultiscaleSolver {
       for (int l = -r; l <= r; ++l, ++k) {
         SurfacePoint q = p;
         if (l || m) walk_cached(surface_, frames_, q, double(l) * a - double(m) * b);
-        const float* v = vals.data() + g.texel(q) * std::size_t(C_);
-        for (int c = 0; c < C_; ++c) o[c] = v[c] * w[std::size_t(k)];
+        const std::size_t tq = g.texel(q);
+        const float* v = vals.data() + tq * std::size_t(C_);
+        const bool known = !visited || (*visited)[tq];
+        for (int c = 0; c < C_; ++c) o[c] = known ? v[c] * w[std::size_t(k)] : std::numeric_limits<float>::quiet_NaN();
         o += C_;
       }
   }
 
-  void target_feature(int l, std::size_t t, const Layout& lay, float* out) const {
+  /// visited: only those current-level texels count (others NaN: causal).
+  void target_feature(int l, std::size_t t, const Layout& lay, float* out,
+                      const std::vector<char>* visited = nullptr) const {
     const SurfacePoint p = grids_[std::size_t(l)].centre(t);
     const std::size_t t0 = frames_.grid.texel(p);
     float* o = out;
-    if (lay.fine) gather(p, t0, l, lay.fine_r, spacing(l), lay.fine_w, o);
+    if (lay.fine) gather(p, t0, l, lay.fine_r, spacing(l), lay.fine_w, o, visited);
     if (lay.coarse) gather(p, t0, l + 1, lay.coarse_r, spacing(l + 1), lay.coarse_w, o);
   }
 
@@ -215,38 +220,82 @@ class MultiscaleSolver {
       std::copy(p, p + C_, next_values.begin() + std::ptrdiff_t(t * std::size_t(C_)));
     };
     if (brute_force) {
-      parallel_chunks(n, 256, progress, [&](std::size_t b, std::size_t end) {
-        std::vector<float> q(static_cast<std::size_t>(D));
-        std::vector<std::pair<float, int>> all(static_cast<std::size_t>(P));
-        for (std::size_t t = b; t < end; ++t) {
-          target_feature(l, t, lay, q.data());
-          const Eigen::Map<const Eigen::RowVectorXf> qv(q.data(), D);
-          for (int i = 0; i < P; ++i) all[std::size_t(i)] = {(X.row(i) - qv).norm(), i};
+      // The coarsest level, in synthesis order and in place: the first pass
+      // compares only the texels visited so far (causal, from random noise
+      // the others), the second the full neighbourhood. Jacobi passes from
+      // noise stayed noise.
+      const bool causal = stream == 100;
+      std::vector<char> visited(n, causal ? 0 : 1);
+      std::vector<float> q(static_cast<std::size_t>(D));
+      std::vector<std::pair<float, int>> all(static_cast<std::size_t>(P));
+      const std::vector<std::size_t> order = synthesis_order(surface_, grids_[std::size_t(l)]);
+      for (std::size_t i = 0; i < n; ++i) {
+        if ((i & 255) == 0) progress.check();
+        const std::size_t t = order[i];
+        target_feature(l, t, lay, q.data(), &visited);
+        bool any = false;
+        for (int d = 0; d < D && !any; ++d) any = !std::isnan(q[std::size_t(d)]);
+        if (any) {
+          for (int p = 0; p < P; ++p) {
+            const float* x = X.row(p).data();
+            float s2 = 0;
+            for (int d = 0; d < D; ++d)
+              if (!std::isnan(q[std::size_t(d)])) s2 += (x[d] - q[std::size_t(d)]) * (x[d] - q[std::size_t(d)]);
+            all[std::size_t(p)] = {std::sqrt(s2), p};
+          }
           std::partial_sort(all.begin(), all.begin() + k, all.end());
           std::vector<std::pair<float, int>> best(all.begin(), all.begin() + k);
-          store(t, pick(best, t, stream));
+          set_texel(l, t, pick(best, t, stream));
         }
-      });
+        visited[t] = 1;
+      }
+      progress.advance(n);
+      return;
     } else {
       const search::Pca pca = search::fit_pca(X, opt_.pca_variance, opt_.max_pca_dims);
       const RowMatrixXf Y = pca.project(X);
       using Tree = nanoflann::KDTreeEigenMatrixAdaptor<RowMatrixXf, -1, nanoflann::metric_L2_Simple>;
       Tree tree(int(Y.cols()), std::cref(Y), 16);
       tree.index->buildIndex();
+      auto search_one = [&](std::size_t t, RowMatrixXf& q, std::vector<Eigen::Index>& idx, std::vector<float>& d2) {
+        target_feature(l, t, lay, q.data());
+        const RowMatrixXf qp = pca.project(q);
+        nanoflann::KNNResultSet<float, Eigen::Index> result(static_cast<std::size_t>(k));
+        result.init(idx.data(), d2.data());
+        tree.index->findNeighbors(result, qp.data(), nanoflann::SearchParams(32, 0.0f));
+        std::vector<std::pair<float, int>> best;
+        for (std::size_t i = 0; i < result.size(); ++i) best.push_back({std::sqrt(d2[i]), int(idx[i])});
+        return pick(best, t, stream);
+      };
+      if (lay.fine) {
+        // Current-level neighbourhoods: in synthesis order, each texel seeing
+        // the ones already updated in this pass (the paper's scanline order);
+        // Jacobi updates of all texels at once did not converge to coherent
+        // patches (window distance 0.74 vs 0.38 for coherent on a flat grid).
+        RowMatrixXf q(1, D);
+        std::vector<Eigen::Index> idx(static_cast<std::size_t>(k));
+        std::vector<float> d2(static_cast<std::size_t>(k));
+        next_values = values_[std::size_t(l)];
+        next_src = src_[std::size_t(l)];
+        values_[std::size_t(l)].swap(next_values);  // read and write the same buffer
+        src_[std::size_t(l)].swap(next_src);
+        const std::vector<std::size_t> order = synthesis_order(surface_, grids_[std::size_t(l)]);
+        for (std::size_t i = 0; i < n; ++i) {
+          if ((i & 1023) == 0) progress.check();
+          const std::size_t t = order[i];
+          const int pixel = search_one(t, q, idx, d2);
+          src_[std::size_t(l)][t] = pixel;
+          const float* p = e.data() + std::size_t(pixel) * std::size_t(C_);
+          std::copy(p, p + C_, values_[std::size_t(l)].begin() + std::ptrdiff_t(t * std::size_t(C_)));
+        }
+        progress.advance(n);
+        return;
+      }
       parallel_chunks(n, 256, progress, [&](std::size_t b, std::size_t end) {
         RowMatrixXf q(1, D);
         std::vector<Eigen::Index> idx(static_cast<std::size_t>(k));
         std::vector<float> d2(static_cast<std::size_t>(k));
-        for (std::size_t t = b; t < end; ++t) {
-          target_feature(l, t, lay, q.data());
-          const RowMatrixXf qp = pca.project(q);
-          nanoflann::KNNResultSet<float, Eigen::Index> result(static_cast<std::size_t>(k));
-          result.init(idx.data(), d2.data());
-          tree.index->findNeighbors(result, qp.data(), nanoflann::SearchParams(32, 0.0f));
-          std::vector<std::pair<float, int>> best;
-          for (std::size_t i = 0; i < result.size(); ++i) best.push_back({std::sqrt(d2[i]), int(idx[i])});
-          store(t, pick(best, t, stream));
-        }
+        for (std::size_t t = b; t < end; ++t) store(t, search_one(t, q, idx, d2));
       });
     }
     values_[std::size_t(l)].swap(next_values);

@@ -22,6 +22,7 @@ void validate_options(const SurfaceSynthesisOptions& o) {
   if (!(o.exemplar_scale > 0) || !std::isfinite(o.exemplar_scale))
     throw InvalidInput("exemplar_scale must be > 0");
   if (o.coherent_radius < 1 || o.coherent_radius > 5) throw InvalidInput("coherent_radius must be in [1, 5]");
+  if (o.coherent_passes < 1 || o.coherent_passes > 8) throw InvalidInput("coherent_passes must be in [1, 8]");
   if (o.fine_neighborhood < 3 || o.fine_neighborhood % 2 == 0 || o.fine_neighborhood > 11)
     throw InvalidInput("fine_neighborhood must be odd, in [3, 11]");
   if (o.coarse_neighborhood < 1 || o.coarse_neighborhood % 2 == 0 || o.coarse_neighborhood > 11)
