@@ -22,15 +22,15 @@
 
 namespace exsynth::surface {
 
-int multiscale_levels(const Image& ex, const TexelGrid& grid, const SurfaceSynthesisOptions& opt) {
+int multiscale_levels(const Image& ex, const TexelGrid&, const SurfaceSynthesisOptions& opt) {
   if (opt.levels > 0) return opt.levels;
-  double mean_res = 0;
-  for (int r : grid.res) mean_res += r;
-  mean_res /= std::max<std::size_t>(grid.res.size(), 1);
+  // Down to an exemplar of 16 to 31 pixels a side (the coarsest level is a
+  // brute-force search over all its pixels), at most 5 levels. Face maps
+  // stop halving at one texel: their coarse levels are then sampled more
+  // densely than they are stored, which the nearest-texel reads allow.
   int levels = 1;
   const int side = std::min(ex.width(), ex.height());
-  while (levels < 4 && (side >> levels) >= std::max(opt.fine_neighborhood, 8) && mean_res / (1 << levels) >= 1.0)
-    ++levels;
+  while (levels < 5 && (side >> levels) >= std::max(opt.fine_neighborhood, 16)) ++levels;
   return levels;
 }
 
@@ -77,8 +77,10 @@ class MultiscaleSolver {
   void run(SurfaceTexture& out) {
     const int top = levels_ - 1;
     init_random(top);
+    prepare_level(top);
     for (int pass = 0; pass < 2; ++pass) run_pass(top, layout(Pass::Coarsest), true, 100 + std::uint64_t(pass));
     for (int l = top - 1; l >= 0; --l) {
+      prepare_level(l);
       run_pass(l, layout(Pass::CoarseOnly), false, 4 * std::uint64_t(l));
       run_pass(l, layout(Pass::Full), false, 4 * std::uint64_t(l) + 1);
       run_pass(l, layout(Pass::Full), false, 4 * std::uint64_t(l) + 2);
@@ -157,32 +159,60 @@ class MultiscaleSolver {
 
   /// Walks the sample grid of radius r at spacing hh around p and copies the
   /// values of the level-`lv` texels the samples land in.
-  void gather(const SurfacePoint& p, std::size_t t0, int lv, int r, double hh, const std::vector<float>& w,
-              float*& o, const std::vector<char>* visited = nullptr) const {
-    const Eigen::Vector3d a = frames_.t1[t0].cast<double>() * hh, b = frames_.t2[t0].cast<double>() * hh;
-    const TexelGrid& g = grids_[std::size_t(lv)];
-    const std::vector<float>& vals = values_[std::size_t(lv)];
-    int k = 0;
-    for (int m = -r; m <= r; ++m)
-      for (int l = -r; l <= r; ++l, ++k) {
-        SurfacePoint q = p;
-        if (l || m) walk_cached(surface_, frames_, q, double(l) * a - double(m) * b);
-        const std::size_t tq = g.texel(q);
-        const float* v = vals.data() + tq * std::size_t(C_);
-        const bool known = !visited || (*visited)[tq];
-        for (int c = 0; c < C_; ++c) o[c] = known ? v[c] * w[std::size_t(k)] : std::numeric_limits<float>::quiet_NaN();
-        o += C_;
+  /// The texels of level `lv` the (2r+1)^2 samples at spacing hh around each
+  /// texel of level l land in: walked once per level (in parallel) and read
+  /// by every pass (the walks are most of the work on fine meshes, where
+  /// coarse neighbourhoods cross many faces).
+  std::vector<std::int32_t> landing_table(int l, int lv, int r, double hh) const {
+    const int per = (2 * r + 1) * (2 * r + 1);
+    const TexelGrid& g = grids_[std::size_t(l)];
+    const TexelGrid& to = grids_[std::size_t(lv)];
+    std::vector<std::int32_t> tab(g.size() * std::size_t(per));
+    StageProgress progress(ctx_, "surface neighbourhoods, level " + std::to_string(l), 0.0, 1.0, g.size());
+    parallel_chunks(g.size(), 512, progress, [&](std::size_t b, std::size_t e) {
+      for (std::size_t t = b; t < e; ++t) {
+        const SurfacePoint p = g.centre(t);
+        const std::size_t t0 = frames_.grid.texel(p);
+        const Eigen::Vector3d a = frames_.t1[t0].cast<double>() * hh, bb = frames_.t2[t0].cast<double>() * hh;
+        int k = 0;
+        for (int m = -r; m <= r; ++m)
+          for (int i = -r; i <= r; ++i, ++k) {
+            SurfacePoint q = p;
+            if (i || m) walk_cached(surface_, frames_, q, double(i) * a - double(m) * bb);
+            tab[t * std::size_t(per) + std::size_t(k)] = std::int32_t(to.texel(q));
+          }
       }
+    });
+    return tab;
+  }
+
+  void gather(const std::int32_t* landing, int lv, int r, const std::vector<float>& w, float*& o,
+              const std::vector<char>* visited = nullptr) const {
+    const std::vector<float>& vals = values_[std::size_t(lv)];
+    const int per = (2 * r + 1) * (2 * r + 1);
+    for (int k = 0; k < per; ++k) {
+      const std::size_t tq = std::size_t(landing[k]);
+      const float* v = vals.data() + tq * std::size_t(C_);
+      const bool known = !visited || (*visited)[tq];
+      for (int c = 0; c < C_; ++c) o[c] = known ? v[c] * w[std::size_t(k)] : std::numeric_limits<float>::quiet_NaN();
+      o += C_;
+    }
   }
 
   /// visited: only those current-level texels count (others NaN: causal).
   void target_feature(int l, std::size_t t, const Layout& lay, float* out,
                       const std::vector<char>* visited = nullptr) const {
-    const SurfacePoint p = grids_[std::size_t(l)].centre(t);
-    const std::size_t t0 = frames_.grid.texel(p);
     float* o = out;
-    if (lay.fine) gather(p, t0, l, lay.fine_r, spacing(l), lay.fine_w, o, visited);
-    if (lay.coarse) gather(p, t0, l + 1, lay.coarse_r, spacing(l + 1), lay.coarse_w, o);
+    const int nf = (2 * lay.fine_r + 1) * (2 * lay.fine_r + 1), nc = (2 * lay.coarse_r + 1) * (2 * lay.coarse_r + 1);
+    if (lay.fine) gather(fine_nb_.data() + t * std::size_t(nf), l, lay.fine_r, lay.fine_w, o, visited);
+    if (lay.coarse) gather(coarse_nb_.data() + t * std::size_t(nc), l + 1, lay.coarse_r, lay.coarse_w, o);
+  }
+
+  /// Walks the neighbourhoods of level l (current and coarser) once.
+  void prepare_level(int l) {
+    const int fr = opt_.fine_neighborhood / 2, cr = opt_.coarse_neighborhood / 2;
+    fine_nb_ = landing_table(l, l, fr, spacing(l));
+    coarse_nb_ = l + 1 < levels_ ? landing_table(l, l + 1, cr, spacing(l + 1)) : std::vector<std::int32_t>{};
   }
 
   /// Among k (distance, pixel) pairs sorted by distance: a random one within
@@ -313,6 +343,7 @@ class MultiscaleSolver {
   std::vector<TexelGrid> grids_;
   std::vector<std::vector<float>> values_;
   std::vector<std::vector<int>> src_;
+  std::vector<std::int32_t> fine_nb_, coarse_nb_;  // landing tables of the level being synthesized
 };
 
 }  // namespace

@@ -40,7 +40,9 @@ double bytes_per_texel(const SurfaceSynthesisOptions& o, int channels) {
   double b = 5 * 12 + 4.0 * channels + 8 + 9;
   if (o.method == SurfaceMethod::Coherent)  // the neighbour table
     b += 12.0 * ((2 * o.coherent_radius + 1) * (2 * o.coherent_radius + 1) - 1);
-  if (o.method == SurfaceMethod::Multiscale) b += (4.0 * channels + 4) * 4.0 / 3.0 + 8;
+  if (o.method == SurfaceMethod::Multiscale)  // pyramid of values, sources + the landing tables
+    b += (4.0 * channels + 4) * 4.0 / 3.0 + 8 +
+         4.0 * (o.fine_neighborhood * o.fine_neighborhood + o.coarse_neighborhood * o.coarse_neighborhood);
   return b;
 }
 
