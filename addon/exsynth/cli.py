@@ -264,6 +264,7 @@ def _parser():
     p.add_argument("--solid-size", type=_int, default=64, help="voxels along the solid's edge (default 64)")
     p.set_defaults(run=_run_demo)
     _points_parser(sub)
+    _add_surface_parser(sub)
     return parser
 
 
@@ -712,6 +713,109 @@ def _input_file(arg, path, allowed):
         _extension(arg, path, allowed)
     mesh_files.check_indices(arg, path)  # what Blender's importers would drop silently
     return path
+
+
+# ---- surface (texture synthesis on subdivision surfaces) ---------------------------
+def _add_surface_parser(sub):
+    from .operators import surface as surface_ops
+
+    p = sub.add_parser(
+        "surface", help="control mesh + exemplar image -> subdivided limit mesh with UVs + atlas PNG",
+        description="Texture synthesis directly on the Catmull-Clark surface of a control mesh (Ying et "
+        "al. 2001): one map per ptex face, packed into one atlas with gutters. OUT.obj is the limit "
+        "mesh (Blender's Subdivision modifier, boundary smooth All, limit surface) with UVs into "
+        "ATLAS.png, which its .mtl names. Coordinates stay those of the files.",
+    )
+    p.add_argument("--mesh", required=True, help="the control mesh: .obj, .ply or .stl")
+    p.add_argument("--exemplar", required=True, help="the exemplar image (any format Blender reads)")
+    p.add_argument("--height", help="a height image of the exemplar's size, synthesized with it: the "
+                   "mesh is displaced along its normal (and --height-out written)")
+    p.add_argument("--alpha", action="store_true", help="synthesize the exemplar's alpha too")
+    p.add_argument("--method", choices=surface_ops.METHODS, default="coherent", help="default coherent")
+    size = p.add_mutually_exclusive_group()
+    size.add_argument("--texels-per-unit", type=_finite, help="texels per unit of surface length")
+    size.add_argument("--face-resolution", type=_int, help="texels along every face map (default 16)")
+    p.add_argument("--exemplar-scale", type=_finite, default=1.0,
+                   help="exemplar pixels per texel; larger makes the pattern smaller (default 1)")
+    field = p.add_mutually_exclusive_group()
+    field.add_argument("--field-preset", choices=tuple(surface_ops.FIELD_MODES.values()), default="smooth",
+                       help="which way the pattern runs (default smooth: a smooth field from --axis)")
+    field.add_argument("--field", help="(V, 3) .npy, a direction per vertex of --mesh (e.g. 'run field')")
+    p.add_argument("--axis", type=_finite, nargs=3, metavar=("X", "Y", "Z"), default=(0.0, 0.0, 1.0),
+                   help="the presets' axis in the file's coordinates (default 0 0 1)")
+    p.add_argument("--segments", type=_int, default=2,
+                   help="limit-mesh quads along each n-gon sub-face, twice that per quad (default 2)")
+    p.add_argument("--height-scale", type=_finite, default=0.02,
+                   help="displacement per unit of height around 0.5 (default 0.02)")
+    p.add_argument("--out", required=True, help="the textured limit mesh: .obj (+ .mtl)")
+    p.add_argument("--texture-out", required=True, help="the atlas: .png")
+    p.add_argument("--height-out", help="with --height: the height atlas, .png")
+    p.add_argument("--seed", type=_seed, default=0, help="random seed (default 0)")
+    p.add_argument("--memory-budget", type=_gib, default=0.0,
+                   help="refuse jobs needing more than this many GiB (default: the engine's 8 GiB)")
+    p.set_defaults(run=_run_surface)
+
+
+def _run_surface(args):
+    from .operators import surface as surface_ops
+
+    mesh_path = _input_file("--mesh", args.mesh, MESH_FORMATS)
+    exemplar_path = _input_file("--exemplar", args.exemplar, None)
+    height_path = _input_file("--height", args.height, None) if args.height else None
+    _require(not args.height_out or args.height, "--height-out needs --height")
+    out = args.outputs.add("--out", args.out, (".obj",))
+    mtl_final = os.path.splitext(args.out)[0] + ".mtl"
+    mtl = args.outputs.add("--out (its .mtl)", mtl_final, (".mtl",))
+    texture_out = args.outputs.add("--texture-out", args.texture_out, (".png",))
+    height_out = args.outputs.add("--height-out", args.height_out, (".png",)) if args.height_out else None
+    _require(args.texels_per_unit is None or args.texels_per_unit > 0,
+             f"--texels-per-unit must be > 0 (got {args.texels_per_unit})")
+    _require(args.face_resolution is None or args.face_resolution > 0,
+             f"--face-resolution must be > 0 (got {args.face_resolution})")
+    _require(args.exemplar_scale > 0, f"--exemplar-scale must be > 0 (got {args.exemplar_scale})")
+    _require(1 <= args.segments <= 32, f"--segments must be in 1..32 (got {args.segments})")
+    _require(any(args.axis) and all(np.isfinite(args.axis)), "--axis must be a finite, non-zero direction")
+
+    objects = import_mesh(mesh_path)
+    _require(bool(objects), f"--mesh: {mesh_path} holds no mesh")
+    obj = _single_mesh(objects, mesh_path) if len(objects) > 1 else objects[0]
+    try:
+        mesh = surface_ops.control_mesh(obj)
+    except jobs.InputError as exc:
+        raise UsageError(f"--mesh: {exc}")
+    field = None
+    if args.field:
+        field = _load_npy("--field", args.field).astype(np.float64)
+        _require(field.shape == mesh.vertices.shape,
+                 f"--field: {args.field} is {field.shape}; --mesh has {len(mesh.vertices)} vertices: give "
+                 f"({len(mesh.vertices)}, 3)")
+    colour = image_io.load(exemplar_path)
+    height = image_io.load(height_path) if height_path else None
+    try:
+        exemplar, channels, encoding = surface_ops.read_exemplar(colour, height, args.alpha)
+    except jobs.InputError as exc:
+        raise UsageError(str(exc))
+    job = surface_ops.SurfaceJob(
+        mesh=mesh, exemplar=exemplar, colour_channels=channels, has_height=height is not None,
+        encoding=encoding, method=args.method, texels_per_unit=args.texels_per_unit or 0.0,
+        face_resolution=args.face_resolution or 16, exemplar_scale=args.exemplar_scale,
+        field_mode=args.field_preset, axis=tuple(args.axis), field=field, height_scale=args.height_scale,
+        segments=args.segments, memory_budget=int(args.memory_budget * GIB), seed=args.seed,
+    )
+    result, seconds = _run_job(job, "surface")
+
+    # Written by exsynth, not Blender's exporter: the files must name each
+    # other by their final names while they are written under temporary ones.
+    atlas = result.atlas[::-1]
+    image_io.save_png(texture_out, atlas[..., :channels], encoding)
+    if height_out:
+        image_io.save_png(height_out, atlas[..., channels:channels + 1], image_io.DATA)
+    mesh_files.write_textured_obj(out, mtl, (args.out, mtl_final, args.texture_out), f"{result.name}_surface",
+                                  result.vertices, result.quads, result.corner_uvs, alpha=channels == 4)
+    h, w = result.atlas.shape[:2]
+    return (f"surface: {result.method} on {os.path.basename(mesh_path)}, {result.texels} texels on "
+            f"{result.faces} faces, field {result.field}, atlas {w}x{h}, {len(result.quads)} quads in "
+            f"{seconds:.2f} s -> {args.out}, {args.texture_out}")
 
 
 # ---- points --------------------------------------------------------------------

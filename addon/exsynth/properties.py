@@ -333,6 +333,66 @@ class ExSynthSettings(bpy.types.PropertyGroup):
                            default=1.0, min=0.0)
     pts_w_d: FloatProperty(name="Direction", description="Coherence: weight of displacement direction "
                            "differences", default=1.0, min=0.0)
+    # ---- Surface Texture (texture synthesis on the subdivision surface) ----
+    surface_exemplar: PointerProperty(
+        name="Exemplar", description="The image whose pattern covers the surface", type=bpy.types.Image,
+    )
+    surface_height: PointerProperty(
+        name="Height",
+        description="Optional height image of the same size, synthesized with the colour: the result "
+        "mesh is displaced along its normal by it (real geometry)",
+        type=bpy.types.Image,
+    )
+    surface_use_alpha: BoolProperty(
+        name="Alpha", description="Synthesize the exemplar's alpha too and wire it to the material's Alpha",
+        default=False,
+    )
+    surface_method: EnumProperty(
+        name="Method",
+        items=(('COHERENT', "Coherent", "One pass copying coherent patches (Ashikhmin): fastest"),
+               ('MULTISCALE', "Multiscale", "Gaussian pyramids, two passes per level (Wei-Levoy)")),
+        default='COHERENT',
+    )
+    surface_size_mode: EnumProperty(
+        name="Texels",
+        items=(('DENSITY', "Density", "Texels per unit of surface length"),
+               ('FACE', "Per Face", "The same map size on every face")),
+        default='DENSITY',
+    )
+    surface_density: FloatProperty(
+        name="Texels per Unit", description="Texels per unit of surface length (world units)",
+        default=64.0, min=1.0, soft_max=2048.0,
+    )
+    surface_face_resolution: IntProperty(
+        name="Face Resolution", description="Texels along each face map's side (an n-gon has n maps)",
+        default=16, min=2, max=512,
+    )
+    surface_exemplar_scale: FloatProperty(
+        name="Exemplar Scale", description="Exemplar pixels per texel: larger makes the pattern smaller",
+        default=1.0, min=0.05, max=16.0,
+    )
+    surface_field: EnumProperty(
+        name="Field",
+        description="Which way the pattern runs on a mesh without an 'exsynth_field' attribute (a mesh "
+        "with one uses it)",
+        items=(('SMOOTH', "Smooth", "A smooth field from the axis, by optimisation"),
+               ('AROUND_AXIS', "Around Axis", "Circles around the axis"),
+               ('ALONG_AXIS', "Along Axis", "The axis laid onto the surface")),
+        default='SMOOTH',
+    )
+    surface_axis: EnumProperty(
+        name="Axis", items=(('X', "X", ""), ('Y', "Y", ""), ('Z', "Z", "")), default='Z',
+    )
+    surface_height_scale: FloatProperty(
+        name="Height Scale", description="Displacement (world units) per unit of height around 0.5",
+        default=0.02, min=0.0, soft_max=1.0, precision=3,
+    )
+    surface_segments: IntProperty(
+        name="Mesh Detail",
+        description="Quads along each n-gon sub-face of the result (quads get twice as many); the "
+        "vertices of Blender's Subdivision level L are those of 2^(L-1)",
+        default=2, min=1, max=32,
+    )
 
     @property
     def memory_budget_bytes(self) -> int:

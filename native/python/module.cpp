@@ -16,6 +16,7 @@ void bind_analogy(py::module_& m);
 void bind_frames(py::module_& m);
 void bind_mesh(py::module_& m);
 void bind_points(py::module_& m);
+void bind_surface(py::module_& m);
 }  // namespace exsynth::py_bind
 
 PYBIND11_MODULE(_native, m) {
@@ -31,4 +32,5 @@ PYBIND11_MODULE(_native, m) {
   exsynth::py_bind::bind_frames(m);
   exsynth::py_bind::bind_mesh(m);
   exsynth::py_bind::bind_points(m);
+  exsynth::py_bind::bind_surface(m);
 }

@@ -15,6 +15,7 @@ No bpy here.
 """
 
 import math
+import os
 
 import numpy as np
 
@@ -126,3 +127,29 @@ def write_obj(path, name, vertices, triangles):
         out.write(f"# exsynth\no {name}\n")
         np.savetxt(out, v, fmt="v %.9g %.9g %.9g")
         np.savetxt(out, f, fmt="f %d %d %d")
+
+
+
+def write_textured_obj(obj_file, mtl_file, final, name, vertices, quads, corner_uvs, alpha=False):
+    """A smooth-shaded quad mesh with per-corner UVs as OBJ + MTL, the
+    material mapping the atlas (Kd; d too with alpha). `obj_file`/`mtl_file`
+    are where to write now; `final` = (OBJ, MTL, atlas PNG) are the paths the
+    files will have (outputs.OutputFiles renames them), which the files name,
+    relative to the OBJ's folder."""
+    final_obj, final_mtl, final_png = (os.path.abspath(p) for p in final)
+    folder = os.path.dirname(final_obj)
+    texture = os.path.relpath(final_png, folder)
+    v = np.asarray(vertices, np.float64).reshape(-1, 3)
+    q = np.asarray(quads, np.int64).reshape(-1, 4) + 1
+    uv = np.asarray(corner_uvs, np.float64).reshape(-1, 2)
+    t = np.arange(1, len(uv) + 1, dtype=np.int64).reshape(-1, 4)
+    with open(mtl_file, "w") as out:
+        out.write(f"# exsynth\nnewmtl {name}\nKd 1 1 1\nmap_Kd {texture}\n")
+        if alpha:
+            out.write(f"map_d {texture}\n")
+    with open(obj_file, "w") as out:
+        out.write(f"# exsynth\nmtllib {os.path.relpath(final_mtl, folder)}\no {name}\n")
+        np.savetxt(out, v, fmt="v %.9g %.9g %.9g")
+        np.savetxt(out, uv, fmt="vt %.9g %.9g")
+        out.write(f"usemtl {name}\ns 1\n")
+        np.savetxt(out, np.stack([q, t], axis=2).reshape(-1, 8), fmt="f %d/%d %d/%d %d/%d %d/%d")

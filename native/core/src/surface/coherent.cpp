@@ -1,0 +1,200 @@
+// Coherent synthesis on the surface (Ying et al. 2001, §5; Ashikhmin 2001):
+// every texel keeps the float exemplar coordinate it was copied from;
+// candidates are the sources of already synthesized texels within the
+// neighbourhood radius, displaced by their tangent-plane offset.
+#include <algorithm>
+#include <cmath>
+#include <deque>
+#include <limits>
+
+#include "exsynth/parallel.hpp"
+#include "exsynth/rng.hpp"
+#include "surface/methods.hpp"
+#include "surface/walk.hpp"
+
+namespace exsynth::surface {
+
+std::vector<std::size_t> synthesis_order(const SubdivSurface& surface, const TexelGrid& grid) {
+  const int nf = surface.ptex_face_count();
+  std::vector<int> entry_edge(std::size_t(nf), -2);  // -2 = not reached, -1 = seed face
+  std::vector<int> faces;
+  faces.reserve(std::size_t(nf));
+  std::deque<int> queue;
+  for (int seed = 0; seed < nf; ++seed) {
+    if (entry_edge[std::size_t(seed)] != -2) continue;
+    entry_edge[std::size_t(seed)] = -1;
+    queue.push_back(seed);
+    while (!queue.empty()) {
+      const int f = queue.front();
+      queue.pop_front();
+      faces.push_back(f);
+      for (int e = 0; e < 4; ++e) {
+        const SubdivSurface::Neighbour nb = surface.neighbour(f, e);
+        if (nb.face < 0 || entry_edge[std::size_t(nb.face)] != -2) continue;
+        entry_edge[std::size_t(nb.face)] = nb.edge;
+        queue.push_back(nb.face);
+      }
+    }
+  }
+  std::vector<std::size_t> order;
+  order.reserve(grid.size());
+  for (int f : faces) {
+    const int r = grid.res[std::size_t(f)];
+    const int e = std::max(entry_edge[std::size_t(f)], 0);
+    for (int row = 0; row < r; ++row)
+      for (int col = 0; col < r; ++col) {
+        double u, v;
+        from_edge(e, (col + 0.5) / r, (row + 0.5) / r, u, v);
+        order.push_back(grid.texel({f, u, v}));
+      }
+  }
+  return order;
+}
+
+namespace {
+
+/// The exemplar pixel nearest to float (x, y): texels copy pixels, never
+/// blends of them (bilinear lookups of the drifting float coordinates blurred
+/// the result: window distance 0.74 vs 0.28 for the 2D synthesis on a flat grid).
+void nearest_exemplar(const Image& ex, double x, double y, bool wrap, float* out) {
+  const int w = ex.width(), h = ex.height();
+  int xi = int(std::floor(x + 0.5)), yi = int(std::floor(y + 0.5));
+  if (wrap) {
+    xi = ((xi % w) + w) % w;
+    yi = ((yi % h) + h) % h;
+  } else {
+    xi = std::clamp(xi, 0, w - 1);
+    yi = std::clamp(yi, 0, h - 1);
+  }
+  const float* p = ex.data() + ex.offset(xi, yi);
+  std::copy(p, p + ex.channels(), out);
+}
+
+/// Per texel, its (2r+1)^2 - 1 neighbours (the centre left out): the texel
+/// each sample lands in (-1 past a boundary) and that texel's offset in
+/// exemplar pixels, corrected by the first-order vector from the landing
+/// point to the texel's centre projected on (v1, -v2). Built in parallel
+/// before the (sequential) synthesis.
+struct NeighbourTable {
+  int per = 0;
+  std::vector<std::int32_t> texel;
+  std::vector<Eigen::Vector2f> offset;
+};
+
+NeighbourTable neighbour_table(const SubdivSurface& surface, const TexelFrames& fr, double h, int r, ExecContext* ctx) {
+  const int n = (2 * r + 1) * (2 * r + 1);
+  NeighbourTable tab;
+  tab.per = n - 1;
+  const std::size_t count = fr.grid.size();
+  tab.texel.resize(count * std::size_t(tab.per));
+  tab.offset.resize(count * std::size_t(tab.per));
+  StageProgress progress(ctx, "surface neighbourhoods", 0.0, 1.0, count);
+  parallel_chunks(count, 1024, progress, [&](std::size_t b, std::size_t e) {
+    SurfacePoint pts[121];
+    bool valid[121];
+    for (std::size_t t = b; t < e; ++t) {
+      sample_points(surface, fr, t, h, r, pts, valid);
+      const Eigen::Vector3d a = fr.t1[t].cast<double>(), bb = fr.t2[t].cast<double>();
+      std::size_t at = t * std::size_t(tab.per);
+      for (int k = 0; k < n; ++k) {
+        const int l = k % (2 * r + 1) - r, m = k / (2 * r + 1) - r;
+        if (l == 0 && m == 0) continue;
+        if (!valid[k]) {
+          tab.texel[at++] = -1;
+          continue;
+        }
+        const SurfacePoint& p = pts[k];
+        const std::size_t q = fr.grid.texel(p);
+        const SurfacePoint c = fr.grid.centre(q);
+        const Eigen::Vector3d to_centre =
+            fr.du[q].cast<double>() * (c.u - p.u) + fr.dv[q].cast<double>() * (c.v - p.v);
+        tab.texel[at] = std::int32_t(q);
+        tab.offset[at++] = Eigen::Vector2f(float(l + to_centre.dot(a) / h), float(m - to_centre.dot(bb) / h));
+      }
+    }
+  });
+  return tab;
+}
+
+}  // namespace
+
+void run_coherent(const SubdivSurface& surface, const TexelFrames& fr, const Image& ex,
+                  const SurfaceSynthesisOptions& opt, SurfaceTexture& out, ExecContext* ctx) {
+  const int C = ex.channels();
+  const double h = out.sample_spacing;
+  const bool wrap = opt.tileable_exemplar;
+  const std::size_t count = fr.grid.size();
+  const NeighbourTable tab = neighbour_table(surface, fr, h, opt.coherent_radius, ctx);
+  const int per = tab.per;
+  const std::vector<std::size_t> order = synthesis_order(surface, fr.grid);
+  std::vector<char> done(count, 0);
+  out.texels.assign(count * std::size_t(C), 0.0f);
+  out.source.assign(count * 2, 0.0f);
+
+  std::vector<Eigen::Vector2d> cands;
+  std::vector<int> known;  // neighbour slots already synthesized
+  std::vector<float> value(static_cast<std::size_t>(C));
+  const double W = ex.width(), H = ex.height();
+  auto inside = [&](Eigen::Vector2d& c) {
+    if (wrap) {
+      c.x() = std::fmod(c.x(), W);
+      if (c.x() < 0) c.x() += W;
+      c.y() = std::fmod(c.y(), H);
+      if (c.y() < 0) c.y() += H;
+      return true;
+    }
+    return c.x() >= 0 && c.y() >= 0 && c.x() <= W - 1 && c.y() <= H - 1;
+  };
+
+  const int passes = std::max(1, opt.coherent_passes);
+  StageProgress progress(ctx, "coherent synthesis", 0.0, 1.0, count * std::size_t(passes));
+  for (std::size_t k = 0; k < count * std::size_t(passes); ++k) {
+    if ((k & 4095) == 0) {
+      progress.check();
+      if (k) progress.advance(4096);
+    }
+    const std::size_t t = order[k % count];
+    const std::int32_t* nb = tab.texel.data() + t * std::size_t(per);
+    const Eigen::Vector2f* off = tab.offset.data() + t * std::size_t(per);
+    known.clear();
+    cands.clear();
+    for (int s = 0; s < per; ++s) {
+      if (nb[s] < 0 || std::size_t(nb[s]) == t || !done[std::size_t(nb[s])]) continue;
+      // Later passes: every neighbour is known; the texel's own source competes too.
+      known.push_back(s);
+      const std::size_t q = std::size_t(nb[s]);
+      Eigen::Vector2d c(out.source[q * 2] - off[s].x(), out.source[q * 2 + 1] - off[s].y());
+      if (!inside(c)) continue;
+      bool seen = false;
+      for (const auto& o : cands) seen = seen || (o - c).squaredNorm() < 0.0625;
+      if (!seen) cands.push_back(c);
+    }
+    if (done[t]) cands.emplace_back(out.source[t * 2], out.source[t * 2 + 1]);
+    Eigen::Vector2d best;
+    if (cands.empty()) {
+      IndexRng rng(opt.seed, t);
+      best = Eigen::Vector2d(double(rng.below(std::uint64_t(W))), double(rng.below(std::uint64_t(H))));
+    } else {
+      double best_d = std::numeric_limits<double>::infinity();
+      for (const auto& c : cands) {
+        double d = 0;
+        for (std::size_t i = 0; i < known.size() && d < best_d; ++i) {
+          const int s = known[i];
+          nearest_exemplar(ex, c.x() + off[s].x(), c.y() + off[s].y(), wrap, value.data());
+          const float* tq = out.texels.data() + std::size_t(nb[s]) * std::size_t(C);
+          for (int ch = 0; ch < C; ++ch) d += double(value[std::size_t(ch)] - tq[ch]) * (value[std::size_t(ch)] - tq[ch]);
+        }
+        if (d < best_d) {
+          best_d = d;
+          best = c;
+        }
+      }
+    }
+    nearest_exemplar(ex, best.x(), best.y(), wrap, out.texels.data() + t * std::size_t(C));
+    out.source[t * 2] = float(best.x());
+    out.source[t * 2 + 1] = float(best.y());
+    done[t] = 1;
+  }
+}
+
+}  // namespace exsynth::surface

@@ -1,0 +1,131 @@
+#include "surface/texels.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "exsynth/parallel.hpp"
+#include "surface/walk.hpp"
+
+namespace exsynth::surface {
+
+TexelGrid::TexelGrid(std::vector<int> resolution) : res(std::move(resolution)) {
+  offset.resize(res.size() + 1, 0);
+  for (std::size_t f = 0; f < res.size(); ++f) offset[f + 1] = offset[f] + std::size_t(res[f]) * std::size_t(res[f]);
+  face_of.resize(size());
+  for (std::size_t f = 0; f < res.size(); ++f)
+    std::fill(face_of.begin() + std::ptrdiff_t(offset[f]), face_of.begin() + std::ptrdiff_t(offset[f + 1]), int(f));
+}
+
+std::size_t TexelGrid::texel(const SurfacePoint& p) const {
+  const int r = res[std::size_t(p.face)];
+  const int i = std::clamp(int(std::floor(p.u * r)), 0, r - 1);
+  const int j = std::clamp(int(std::floor(p.v * r)), 0, r - 1);
+  return offset[std::size_t(p.face)] + std::size_t(j) * std::size_t(r) + std::size_t(i);
+}
+
+SurfacePoint TexelGrid::centre(std::size_t t) const {
+  const int f = face_of[t];
+  const int r = res[std::size_t(f)];
+  const std::size_t k = t - offset[std::size_t(f)];
+  return {f, (double(k % std::size_t(r)) + 0.5) / r, (double(k / std::size_t(r)) + 0.5) / r};
+}
+
+TexelGrid TexelGrid::coarser() const {
+  std::vector<int> r(res.size());
+  for (std::size_t f = 0; f < res.size(); ++f) r[f] = std::max(1, res[f] / 2);
+  return TexelGrid(std::move(r));
+}
+
+LimitFrame TexelFrames::approx(const SurfacePoint& p) const {
+  const std::size_t t = grid.texel(p);
+  const SurfacePoint c = grid.centre(t);
+  LimitFrame f;
+  f.du = du[t].cast<double>();
+  f.dv = dv[t].cast<double>();
+  f.position = position[t].cast<double>() + f.du * (p.u - c.u) + f.dv * (p.v - c.v);
+  return f;
+}
+
+TexelFrames build_texel_frames(const SubdivSurface& surface, TexelGrid grid,
+                               const std::vector<Eigen::Vector3f>& field, ExecContext* ctx) {
+  TexelFrames fr;
+  fr.grid = std::move(grid);
+  const std::size_t n = fr.grid.size();
+  fr.position.resize(n);
+  fr.du.resize(n);
+  fr.dv.resize(n);
+  fr.t1.resize(n);
+  fr.t2.resize(n);
+  std::vector<float> flat(field.size() * 3);
+  for (std::size_t i = 0; i < field.size(); ++i)
+    for (int k = 0; k < 3; ++k) flat[i * 3 + std::size_t(k)] = field[i][k];
+  const SubdivSurface::VertexData data = surface.prepare_vertex_data(flat, 3);
+  StageProgress progress(ctx, "surface frames", 0.0, 1.0, n);
+  parallel_chunks(n, 4096, progress, [&](std::size_t b, std::size_t e) {
+    for (std::size_t t = b; t < e; ++t) {
+      const SurfacePoint p = fr.grid.centre(t);
+      const LimitFrame lf = surface.evaluate(p);
+      double v[3];
+      surface.evaluate_data(data, p, v);
+      const Eigen::Vector3d nrm = lf.du.cross(lf.dv).normalized();
+      Eigen::Vector3d a(v[0], v[1], v[2]);
+      a -= a.dot(nrm) * nrm;
+      if (!(a.norm() > 1e-6)) a = lf.du;
+      a.normalize();
+      fr.position[t] = lf.position.cast<float>();
+      fr.du[t] = lf.du.cast<float>();
+      fr.dv[t] = lf.dv.cast<float>();
+      fr.t1[t] = a.cast<float>();
+      fr.t2[t] = nrm.cross(a).normalized().cast<float>();
+    }
+  });
+  return fr;
+}
+
+// The cache is linear per texel (no need for short steps) and only
+// piecewise smooth (loose tolerance, few corrections, slide along edges).
+constexpr WalkParams kCachedWalk{1e-3, 1.0, 3, true};
+
+bool walk_cached(const SubdivSurface& surface, const TexelFrames& frames, SurfacePoint& p,
+                 const Eigen::Vector3d& d) {
+  return walk_surface([&](const SurfacePoint& q) { return frames.approx(q); },
+                      [&](int f, int e, double t) { return surface.cross_edge(f, e, t); }, p, d, kCachedWalk);
+}
+
+void sample_points(const SubdivSurface& surface, const TexelFrames& frames, std::size_t t, double h, int r,
+                   SurfacePoint* out, bool* valid) {
+  const SurfacePoint c = frames.grid.centre(t);
+  const Eigen::Vector3d a = frames.t1[t].cast<double>() * h, b = frames.t2[t].cast<double>() * h;
+  int k = 0;
+  for (int m = -r; m <= r; ++m)
+    for (int l = -r; l <= r; ++l, ++k) {
+      SurfacePoint p = c;
+      valid[k] = (l == 0 && m == 0) ? true : walk_cached(surface, frames, p, double(l) * a - double(m) * b);
+      out[k] = p;
+    }
+}
+
+void sample_exemplar(const Image& ex, double x, double y, bool wrap, float* out) {
+  const int w = ex.width(), h = ex.height(), c = ex.channels();
+  if (wrap) {
+    x = std::fmod(x, double(w));
+    if (x < 0) x += w;
+    y = std::fmod(y, double(h));
+    if (y < 0) y += h;
+  } else {
+    x = std::clamp(x, 0.0, double(w - 1));
+    y = std::clamp(y, 0.0, double(h - 1));
+  }
+  const int x0 = std::min(int(x), w - 1), y0 = std::min(int(y), h - 1);
+  const int x1 = wrap ? (x0 + 1) % w : std::min(x0 + 1, w - 1);
+  const int y1 = wrap ? (y0 + 1) % h : std::min(y0 + 1, h - 1);
+  const float fx = float(x - x0), fy = float(y - y0);
+  const float* p00 = ex.data() + ex.offset(x0, y0);
+  const float* p10 = ex.data() + ex.offset(x1, y0);
+  const float* p01 = ex.data() + ex.offset(x0, y1);
+  const float* p11 = ex.data() + ex.offset(x1, y1);
+  for (int k = 0; k < c; ++k)
+    out[k] = (1 - fy) * ((1 - fx) * p00[k] + fx * p10[k]) + fy * ((1 - fx) * p01[k] + fx * p11[k]);
+}
+
+}  // namespace exsynth::surface
