@@ -85,7 +85,7 @@ void ExemplarIndex::project(StageProgress& progress) {
 // windows that overlap it by more than half (near-copies of itself, which
 // would give the search no new choices). Exact k-NN of every window in the
 // full PCA space is slow in a k-d tree (32 dimensions: 19 s at 121^2
-// windows, measured) and mostly returns those near-copies. So: a tree over
+// windows on a shared, loaded machine) and mostly returns those near-copies. So: a tree over
 // the windows at even (u, v) only, in their leading kTreeDims
 // coefficients, proposes kCandidates non-overlapping windows; each and its
 // 8 one-pixel shifts are ranked by the full PCA distance. ~N log N; the
