@@ -1,5 +1,7 @@
 // Errors and ExecContext: the pieces every binding area shares.
 #include <pybind11/pybind11.h>
+#include <tbb/global_control.h>
+#include <tbb/task_arena.h>
 
 #include "exsynth/errors.hpp"
 #include "exsynth/exec_context.hpp"
@@ -79,6 +81,21 @@ void bind_core(py::module_& m) {
         return "<ExecContext stage='" + c.stage() + "' progress=" + std::to_string(c.progress()) +
                (c.cancelled() ? " cancelled>" : ">");
       });
+
+  m.def(
+      "with_threads",
+      [](const IntArg& threads, const py::object& fn) {
+        const int n = int_arg(threads, "threads", 1, 256);
+        if (!PyCallable_Check(fn.ptr())) throw InvalidInput("'fn' must be callable, got " + short_repr(fn));
+        // An arena of n slots under a cap of n runs the engine's parallel
+        // loops started from fn on exactly n threads, even beyond the cores.
+        tbb::global_control cap(tbb::global_control::max_allowed_parallelism, std::size_t(n));
+        tbb::task_arena arena(n);
+        return arena.execute([&] { return fn(); });
+      },
+      py::arg("threads"), py::arg("fn"),
+      "Call fn() with the engine's parallel work on exactly `threads` threads (1..256; more than the\n"
+      "machine's cores is allowed): e.g. 1 to leave the other cores free. Results do not depend on it.");
 
   m.attr("DEFAULT_MEMORY_BUDGET") = py::int_(kDefaultMemoryBudget);
 }

@@ -7,6 +7,12 @@ import pytest
 ASSETS = Path(__file__).resolve().parents[2] / "assets"
 
 
+def pytest_configure(config):
+    # The sanitizer tier (./exsynth test --sanitize) runs with -m "not heavy":
+    # tests that take more than ~20 s under ASan (measured) carry this mark.
+    config.addinivalue_line("markers", "heavy: too slow for the sanitizer tier (still run in tier 2)")
+
+
 def load_obj(path):
     """Tiny OBJ reader for tests (v and f lines, polygons fanned)."""
     verts, faces = [], []

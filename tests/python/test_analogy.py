@@ -9,6 +9,7 @@ def inside(sdf, h):
     return float((sdf < 0).sum()) * h**3
 
 
+@pytest.mark.heavy  # 15-50 s under ASan; the C++ tier covers the analogy there
 def test_dilation_pair_grows_the_voxelized_bunny(bunny):
     pair = _native.make_exemplar_pair("dilate", resolution=32)
     h = pair["voxel_size"]  # 2 / 32: the pair spans [-1, 1]^3
@@ -56,6 +57,7 @@ def surface_area(sdf, origin, h):
     return 0.5 * np.linalg.norm(np.cross(b - a, c - a), axis=1).sum()
 
 
+@pytest.mark.heavy  # 15-50 s under ASan; the C++ tier covers the analogy there
 def test_field_aligned_grooves_run_around_the_bunny(bunny):
     vox, frames, res = textured_bunny(bunny, "grooves")
     bp, h = res["b_prime"], vox["voxel_size"]
@@ -72,6 +74,7 @@ def test_field_aligned_grooves_run_around_the_bunny(bunny):
     assert ((vox["sdf"] < -h) & (bp > 0)).sum() > 0.025 * (vox["sdf"] < 0).sum()
 
 
+@pytest.mark.heavy  # 15-50 s under ASan; the C++ tier covers the analogy there
 def test_field_aligned_spikes_grow_out_of_the_bunny(bunny):
     vox, frames, res = textured_bunny(bunny, "spikes")
     bp, b, h = res["b_prime"], vox["sdf"], vox["voxel_size"]
@@ -80,6 +83,7 @@ def test_field_aligned_spikes_grow_out_of_the_bunny(bunny):
     assert grown.sum() > 0.003 * (b < 0).sum()
 
 
+@pytest.mark.heavy  # 15-50 s under ASan; the C++ tier covers the analogy there
 def test_field_aligned_analogy_is_deterministic(bunny):
     _, _, one = textured_bunny(bunny, "pits", resolution=40)
     _, _, two = textured_bunny(bunny, "pits", resolution=40)
