@@ -32,7 +32,7 @@ def scaled_bunny(path, scale):
 
 
 @pytest.mark.parametrize("args, message", [
-    (["--preset", "dilate", "--dilation", "-5"], "--dilation must be a finite number > 0, got -5"),
+    (["--preset", "dilate", "--dilation", "-5"], "'--dilation' must be a finite number > 0"),
     (["--preset", "spikes", "--spike-height", "5"], "--spike-height (5) plus half the thickness"),
 ])
 def test_pair_options_are_named_as_the_user_gave_them(tmp_path, capsys, args, message):
