@@ -471,6 +471,7 @@ def _run_solid(args):
         paths.append(_input_file(arg, path, None) if path else None)
     _require(args.size > 0, f"--size must be > 0 (got {args.size})")
     _require(args.levels > 0, f"--levels must be > 0 (got {args.levels})")
+    _texture_size("--size", (args.size,), args.levels, _native.SOLID_MAX_SIZE, "voxels")
     _require(args.iterations > 0, f"--iterations must be > 0 (got {args.iterations})")
     _require(args.scale >= 0, f"--scale must be >= 0 (got {args.scale}); 0 picks it from the mesh")
     _require(args.memory_budget >= 0, f"--memory-budget must be >= 0 GiB (got {args.memory_budget})")
@@ -524,6 +525,7 @@ def _run_image(args):
     _require(args.width > 0 and args.height > 0,
              f"--width and --height must be > 0 (got {args.width}x{args.height})")
     _require(args.levels > 0, f"--levels must be > 0 (got {args.levels})")
+    _texture_size("--width and --height", (args.width, args.height), args.levels, _native.IMAGE_MAX_SIZE, "pixels")
     _require(args.iterations > 0, f"--iterations must be > 0 (got {args.iterations})")
     _require(args.memory_budget >= 0, f"--memory-budget must be >= 0 GiB (got {args.memory_budget})")
 
@@ -539,6 +541,18 @@ def _run_image(args):
     tile = ", tileable" if args.tileable else ""
     return (f"image: {args.width}x{args.height}{tile} from {os.path.basename(exemplar_path)} "
             f"in {seconds:.2f} s -> {args.out}")
+
+
+def _texture_size(option, sizes, levels, largest, unit):
+    """The engine's one size rule (the coarsest level holds a neighbourhood),
+    refused here as a bad argument that names the option."""
+    if levels > 8:
+        return  # the engine names --levels' own range
+    smallest = _native.min_texture_size(levels)
+    _require(all(smallest <= n <= largest for n in sizes),
+             f"{option} must be {smallest}..{largest} {unit} with --levels {levels} (got "
+             f"{'x'.join(map(str, sizes))}); give a larger size or fewer --levels (1 level allows from "
+             f"{_native.min_texture_size(1)})")
 
 
 def _single_mesh(objects, path):

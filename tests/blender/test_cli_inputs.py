@@ -11,7 +11,7 @@ import pytest
 
 from exsynth import cli
 from exsynth.operators import voxelize as voxelize_ops
-from helpers import BUNNY_OBJ, read_obj, scene_state
+from helpers import BUNNY_OBJ, TEXTURES, read_obj, scene_state
 
 B = ["analogy", "--b", BUNNY_OBJ, "--resolution", "24"]
 
@@ -160,4 +160,16 @@ def test_analogy_budget_message_names_what_the_cli_can_change(tmp_path, capsys):
     assert code == 1
     assert "over the memory budget" in err and "lower the resolution or raise the memory budget" in err
     assert "voxel_size" not in err
+    assert os.listdir(tmp_path) == []
+
+
+@pytest.mark.parametrize("args, message", [
+    (["image", "--width", "64", "--height", "3", "--out", "x.png"],
+     "--width and --height must be 29..16384 pixels with --levels 3 (got 64x3)"),
+    (["solid", "--size", "1", "--out", "x.npy"], "--size must be 29..2048 voxels with --levels 3 (got 1)"),
+])
+def test_texture_sizes_follow_the_engine_rule_by_option_name(tmp_path, monkeypatch, capsys, args, message):
+    monkeypatch.chdir(tmp_path)
+    code, err = run(capsys, args[0], "--exemplar", os.path.join(TEXTURES, "crackedground.png"), *args[1:])
+    assert code == 2 and message in err and "voxels across" not in err
     assert os.listdir(tmp_path) == []
