@@ -4,6 +4,7 @@
 
 #include <string>
 
+#include "arguments.hpp"
 #include "arrays.hpp"
 #include "exsynth/mesh.hpp"
 
@@ -14,7 +15,9 @@ namespace exsynth::py_bind {
 void bind_mesh(py::module_& m) {
   m.def(
       "validate_mesh",
-      [](const py::array& vertices, const py::array& faces, const std::string& name) {
+      [](const ArrayArg& vertices, const ArrayArg& faces, const StrArg& name_arg, const py::kwargs& extra) {
+        reject_unknown(extra, "vertices, faces, name");
+        const std::string name = string_arg(name_arg, "name", "how messages refer to the mesh");
         validate_mesh(to_mesh(vertices, faces), name.c_str());
       },
       py::arg("vertices"), py::arg("faces"), py::arg("name") = "mesh",

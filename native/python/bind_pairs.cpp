@@ -17,6 +17,8 @@ constexpr const char* kOptionNames =
     "thickness, spacing, feature_radius, feature_height, jitter, cylinder_radius, groove_direction, "
     "sphere_radius, dilation, memory_budget";
 
+constexpr const char* kPresetNames = "'spikes', 'pits', 'holes', 'grooves' or 'dilate'";
+
 PairPreset to_preset(const std::string& s) {
   if (s == "spikes") return PairPreset::Spikes;
   if (s == "pits") return PairPreset::Pits;
@@ -58,11 +60,12 @@ void apply_options(PairOptions& o, const py::kwargs& kw) {
 void bind_pairs(py::module_& m) {
   m.def(
       "check_exemplar_pair",
-      [](const std::string& preset, int resolution, const py::kwargs& kw) {
+      [](const StrArg& preset, const IntArg& resolution, const py::kwargs& kw) {
         PairOptions opt;
-        opt.resolution = resolution;
+        opt.resolution = int_arg(resolution, "resolution", kMinPairResolution, kMaxPairResolution, "voxels per grid edge");
         apply_options(opt, kw);
-        validate_pair_options(to_preset(preset), opt);
+        const PairPreset p = to_preset(string_arg(preset, "preset", kPresetNames));
+        validate_pair_options(p, opt);
       },
       py::arg("preset") = "spikes", py::kw_only(), py::arg("resolution") = 64,
       R"doc(Raise InvalidInputError if make_exemplar_pair would refuse these options (same
@@ -77,7 +80,7 @@ arguments, nothing built): lets a caller refuse a job before it starts.)doc");
         opt.seed = seed_arg(seed);
         ExecContext* ctx = context_arg(ctx_arg);
         apply_options(opt, kw);
-        const PairPreset p = to_preset(string_arg(preset, "preset", "'spikes', 'pits', 'holes', 'grooves' or 'dilate'"));
+        const PairPreset p = to_preset(string_arg(preset, "preset", kPresetNames));
         ExemplarPair pair;
         {
           py::gil_scoped_release release;

@@ -101,7 +101,14 @@ py::list to_list(const std::vector<double>& v) {
 }  // namespace
 
 void bind_solid(py::module_& m) {
-  m.def("min_texture_size", &min_texture_size, py::arg("levels") = 3, py::arg("neighborhood") = 8,
+  m.def(
+      "min_texture_size",
+      [](const IntArg& levels, const IntArg& neighborhood, const py::kwargs& extra) {
+        reject_unknown(extra, "levels, neighborhood");
+        // Ranges as set_common's (solid/synthesize.cpp's check_options).
+        return min_texture_size(int_arg(levels, "levels", 1, 8), int_arg(neighborhood, "neighborhood", 3, 32));
+      },
+      py::arg("levels") = 3, py::arg("neighborhood") = 8,
         "Smallest solid size / image width and height accepted with these levels and neighbourhood: the "
         "coarsest level must hold one neighbourhood ((neighborhood - 1) * 2^(levels - 1) + 1; 29 by default).");
   m.attr("SOLID_MAX_SIZE") = kMaxSolidSize;

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <string>
 
+#include "arguments.hpp"
 #include "arrays.hpp"
 #include "exsynth/errors.hpp"
 #include "exsynth/surface.hpp"
@@ -16,7 +17,11 @@ namespace {
 
 /// vertices (V, 3) float, face_sizes (F,) int, face_vertices (sum,) int -> PolygonMesh.
 /// Index range, manifoldness and areas are checked by the core.
-PolygonMesh to_polygon_mesh(const py::array& vertices, const py::array& face_sizes, const py::array& face_vertices) {
+PolygonMesh to_polygon_mesh(const py::handle& vertices_arg, const py::handle& face_sizes_arg,
+                            const py::handle& face_vertices_arg) {
+  const py::array vertices = array_arg(vertices_arg, "vertices", "a (V, 3) float32/float64 array");
+  const py::array face_sizes = array_arg(face_sizes_arg, "face_sizes", "an (F,) int32/int64 array");
+  const py::array face_vertices = array_arg(face_vertices_arg, "face_vertices", "a (sum of face_sizes,) int32/int64 array");
   check_shape(vertices, "vertices", {-1, 3}, "(V, 3) float32/float64");
   if (!vertices.dtype().is(py::dtype::of<float>()) && !vertices.dtype().is(py::dtype::of<double>()))
     throw InvalidInput("'vertices' must have dtype float32 or float64, got " + describe(vertices));
@@ -47,7 +52,8 @@ PolygonMesh to_polygon_mesh(const py::array& vertices, const py::array& face_siz
 }
 
 /// (H, W) or (H, W, C) uint8 / uint16 (scaled to [0, 1]) or float32 / float64.
-Image to_exemplar(const py::array& a) {
+Image to_exemplar(const py::handle& arg) {
+  const py::array a = array_arg(arg, "exemplar", "an (H, W) or (H, W, C) image array");
   if (a.ndim() != 2 && a.ndim() != 3)
     throw InvalidInput("'exemplar' must be an (H, W) or (H, W, C) image array, got a " + describe(a));
   const int h = int(a.shape(0)), w = int(a.shape(1)), c = a.ndim() == 3 ? int(a.shape(2)) : 1;
@@ -71,7 +77,8 @@ Image to_exemplar(const py::array& a) {
   return img;
 }
 
-std::vector<Eigen::Vector3f> to_field(const py::array& a, std::size_t vertices) {
+std::vector<Eigen::Vector3f> to_field(const py::handle& arg, std::size_t vertices) {
+  const py::array a = array_arg(arg, "field", "a (V, 3) float array, one vector per control vertex");
   check_shape(a, "field", {py::ssize_t(vertices), 3}, "(V, 3) float, one vector per control vertex");
   const auto d_arr = py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(a);
   auto d = d_arr.unchecked<2>();
@@ -83,52 +90,58 @@ std::vector<Eigen::Vector3f> to_field(const py::array& a, std::size_t vertices) 
   return out;
 }
 
+constexpr const char* kOptionNames =
+    "method, texels_per_unit, face_resolution, min_face_resolution, max_face_resolution, exemplar_scale, "
+    "coherent_radius, coherent_passes, levels, fine_neighborhood, coarse_neighborhood, knn, knn_tolerance, "
+    "pca_variance, max_pca_dims, tileable_exemplar, field_axis, memory_budget, seed, gutter, segments, "
+    "displacement_(channel, scale, midlevel)";  // compact: the whole message stays under 400 characters
+
+// Per-face resolutions above this would not fit a memory budget anyway; the
+// core checks min <= face <= max between them.
+constexpr int kMaxFaceResolution = 1 << 14;
+
 void set_options(SurfaceSynthesisOptions& o, SurfaceOutputOptions& out, const py::kwargs& kw) {
   for (auto item : kw) {
     const std::string k = py::str(item.first);
     const py::handle v = item.second;
+    // Ranges as surface/synthesize.cpp's validate_options and atlas.cpp (which check them again).
     if (k == "method") {
-      const std::string m = v.cast<std::string>();
+      const std::string m = string_arg(v, k, "'coherent' or 'multiscale'");
       if (m == "coherent") o.method = SurfaceMethod::Coherent;
       else if (m == "multiscale") o.method = SurfaceMethod::Multiscale;
       else throw InvalidInput("method must be 'coherent' or 'multiscale', got '" + m + "'");
-    } else if (k == "texels_per_unit") o.texels_per_unit = v.cast<double>();
-    else if (k == "face_resolution") o.face_resolution = v.cast<int>();
-    else if (k == "min_face_resolution") o.min_face_resolution = v.cast<int>();
-    else if (k == "max_face_resolution") o.max_face_resolution = v.cast<int>();
-    else if (k == "exemplar_scale") o.exemplar_scale = v.cast<double>();
-    else if (k == "coherent_radius") o.coherent_radius = v.cast<int>();
-    else if (k == "coherent_passes") o.coherent_passes = v.cast<int>();
-    else if (k == "levels") o.levels = v.cast<int>();
-    else if (k == "fine_neighborhood") o.fine_neighborhood = v.cast<int>();
-    else if (k == "coarse_neighborhood") o.coarse_neighborhood = v.cast<int>();
-    else if (k == "knn") o.knn = v.cast<int>();
-    else if (k == "knn_tolerance") o.knn_tolerance = v.cast<double>();
-    else if (k == "pca_variance") o.pca_variance = v.cast<double>();
-    else if (k == "max_pca_dims") o.max_pca_dims = v.cast<int>();
-    else if (k == "tileable_exemplar") o.tileable_exemplar = v.cast<bool>();
+    } else if (k == "texels_per_unit") o.texels_per_unit = real_arg(v, k, 0.0, kInf, Ends::Closed, "0 = face_resolution");
+    else if (k == "face_resolution") o.face_resolution = int_arg(v, k, 1, kMaxFaceResolution, "texels per face edge");
+    else if (k == "min_face_resolution") o.min_face_resolution = int_arg(v, k, 1, kMaxFaceResolution, "texels per face edge");
+    else if (k == "max_face_resolution") o.max_face_resolution = int_arg(v, k, 1, kMaxFaceResolution, "texels per face edge");
+    else if (k == "exemplar_scale") o.exemplar_scale = real_arg(v, k, 0.0, kInf, Ends::OpenLow);
+    else if (k == "coherent_radius") o.coherent_radius = int_arg(v, k, 1, 5);
+    else if (k == "coherent_passes") o.coherent_passes = int_arg(v, k, 1, 8);
+    else if (k == "levels") o.levels = int_arg(v, k, 0, 6, "0 = automatic");
+    else if (k == "fine_neighborhood") o.fine_neighborhood = int_arg(v, k, 3, 11, "odd");
+    else if (k == "coarse_neighborhood") o.coarse_neighborhood = int_arg(v, k, 1, 11, "odd");
+    else if (k == "knn") o.knn = int_arg(v, k, 1, 64);
+    else if (k == "knn_tolerance") o.knn_tolerance = real_arg(v, k, 0.0, kInf);
+    else if (k == "pca_variance") o.pca_variance = real_arg(v, k, 0.0, 1.0, Ends::OpenLow);
+    else if (k == "max_pca_dims") o.max_pca_dims = int_arg(v, k, 1, 4096);
+    else if (k == "tileable_exemplar") o.tileable_exemplar = bool_arg(v, k);
     else if (k == "field_axis") {
-      auto a = py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(v);
-      if (!a || a.ndim() != 1 || a.shape(0) != 3) throw InvalidInput("'field_axis' must be 3 numbers");
+      const char* expected = "3 finite numbers, not all zero";
+      const py::array given = array_arg(v, k, expected);
+      auto a = py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(given);
+      if (!a || a.ndim() != 1 || a.shape(0) != 3)
+        throw InvalidInput("'field_axis' must be " + std::string(expected) + ", got " + short_repr(v));
       o.field_axis = Eigen::Vector3f(float(a.at(0)), float(a.at(1)), float(a.at(2)));
       if (!o.field_axis.allFinite() || o.field_axis.norm() == 0)
-        throw InvalidInput("'field_axis' must be a finite, non-zero vector");
-    } else if (k == "memory_budget") {
-      const auto b = v.cast<std::size_t>();
-      o.memory_budget = b ? b : kDefaultMemoryBudget;
-    } else if (k == "seed") o.seed = v.cast<std::uint64_t>();
-    else if (k == "gutter") out.gutter = v.cast<int>();
-    else if (k == "segments") out.segments = v.cast<int>();
-    else if (k == "displacement_channel") out.displacement_channel = v.cast<int>();
-    else if (k == "displacement_scale") out.displacement_scale = v.cast<double>();
-    else if (k == "displacement_midlevel") out.displacement_midlevel = v.cast<double>();
-    else
-      throw InvalidInput("unknown option '" + k +
-                         "'; options: method, texels_per_unit, face_resolution, min_face_resolution, "
-                         "max_face_resolution, exemplar_scale, coherent_radius, coherent_passes, levels, fine_neighborhood, "
-                         "coarse_neighborhood, knn, knn_tolerance, pca_variance, max_pca_dims, tileable_exemplar, "
-                         "field_axis, memory_budget, seed, gutter, segments, displacement_channel, "
-                         "displacement_scale, displacement_midlevel");
+        throw InvalidInput("'field_axis' must be " + std::string(expected) + ", got " + short_repr(v));
+    } else if (k == "memory_budget") o.memory_budget = memory_budget_arg(v, k);
+    else if (k == "seed") o.seed = seed_arg(v, k);
+    else if (k == "gutter") out.gutter = int_arg(v, k, 0, 16, "texels");
+    else if (k == "segments") out.segments = int_arg(v, k, 1, 64, "per face");
+    else if (k == "displacement_channel") out.displacement_channel = int_arg(v, k, -1, 15, "-1 = none");
+    else if (k == "displacement_scale") out.displacement_scale = real_arg(v, k);
+    else if (k == "displacement_midlevel") out.displacement_midlevel = real_arg(v, k);
+    else throw InvalidInput("unknown option '" + k + "'; options: " + kOptionNames);
   }
 }
 
@@ -145,14 +158,15 @@ py::array flatten(const std::vector<Eigen::Matrix<T, N, 1>>& v) {
 void bind_surface(py::module_& m) {
   m.def(
       "texture_surface",
-      [](const py::array& vertices, const py::array& face_sizes, const py::array& face_vertices,
-         const py::array& exemplar, const py::object& field, ExecContext* ctx, const py::kwargs& kw) {
-        const PolygonMesh mesh = to_polygon_mesh(vertices, face_sizes, face_vertices);
-        const Image ex = to_exemplar(exemplar);
+      [](const ArrayArg& vertices, const ArrayArg& face_sizes, const ArrayArg& face_vertices,
+         const ArrayArg& exemplar, const OptionalArrayArg& field, const ContextArg& ctx_arg, const py::kwargs& kw) {
         SurfaceSynthesisOptions opt;
         SurfaceOutputOptions out;
         set_options(opt, out, kw);
-        if (!field.is_none()) opt.field = to_field(field.cast<py::array>(), mesh.vertices.size());
+        ExecContext* ctx = context_arg(ctx_arg);
+        const PolygonMesh mesh = to_polygon_mesh(vertices, face_sizes, face_vertices);
+        const Image ex = to_exemplar(exemplar);
+        if (!field.is_none()) opt.field = to_field(field, mesh.vertices.size());
         SurfaceResult r;
         {
           py::gil_scoped_release release;
@@ -176,7 +190,7 @@ void bind_surface(py::module_& m) {
         return d;
       },
       py::arg("vertices"), py::arg("face_sizes"), py::arg("face_vertices"), py::arg("exemplar"), py::kw_only(),
-      py::arg("field") = py::none(), py::arg("ctx") = static_cast<ExecContext*>(nullptr),
+      py::arg("field") = py::none(), py::arg("ctx") = py::none(),
       R"doc(Texture synthesis on the Catmull-Clark limit surface of a control mesh (Ying et al. 2001).
 
 vertices (V, 3) float; face_sizes (F,) int; face_vertices (sum face_sizes,) int, counter-clockwise.
@@ -195,9 +209,12 @@ Returns {'atlas': (H, W, C) float32 (row 0 = top), 'vertices': (N, 3), 'normals'
 
   m.def(
       "surface_limit_points",
-      [](const py::array& vertices, const py::array& face_sizes, const py::array& face_vertices,
-         const py::array& faces, const py::array& uv) {
+      [](const ArrayArg& vertices, const ArrayArg& face_sizes, const ArrayArg& face_vertices,
+         const ArrayArg& faces_arg, const ArrayArg& uv_arg, const py::kwargs& extra) {
+        reject_unknown(extra, "vertices, face_sizes, face_vertices, faces, uv");
         const PolygonMesh mesh = to_polygon_mesh(vertices, face_sizes, face_vertices);
+        const py::array faces = array_arg(faces_arg, "faces", "an (N,) int array of ptex face indices");
+        const py::array uv = array_arg(uv_arg, "uv", "an (N, 2) float array in [0, 1]");
         check_shape(faces, "faces", {-1}, "(N,) int ptex face indices");
         check_shape(uv, "uv", {faces.shape(0), 2}, "(N, 2) float in [0, 1]");
         const auto f_arr = py::array_t<long long, py::array::c_style | py::array::forcecast>::ensure(faces);
@@ -235,12 +252,12 @@ Returns {'atlas': (H, W, C) float32 (row 0 = top), 'vertices': (N, 3), 'normals'
 
   m.def(
       "surface_texel_count",
-      [](const py::array& vertices, const py::array& face_sizes, const py::array& face_vertices,
+      [](const ArrayArg& vertices, const ArrayArg& face_sizes, const ArrayArg& face_vertices,
          const py::kwargs& kw) {
-        const PolygonMesh mesh = to_polygon_mesh(vertices, face_sizes, face_vertices);
         SurfaceSynthesisOptions opt;
         SurfaceOutputOptions out;
         set_options(opt, out, kw);
+        const PolygonMesh mesh = to_polygon_mesh(vertices, face_sizes, face_vertices);
         std::vector<int> res;
         {
           py::gil_scoped_release release;

@@ -23,6 +23,11 @@ PTS = np.array([[0, 0, 0], [1, 1, 1]], np.float32)
 DIRS = np.array([[1, 0, 0], [1, 0, 0]], np.float32)
 GIVEN = np.zeros_like(VERTS)
 GIVEN[1] = [1, 0, 0]
+# One quad (a control mesh for the surface functions) and a flat height field.
+QUAD_V = np.array([[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0]], float)
+QUAD_SIZES = np.array([4], np.int32)
+QUAD_FV = np.array([0, 1, 2, 3], np.int32)
+HEIGHTS = np.zeros((20, 20), np.float32)
 
 
 def call(name, *args, **kwargs):
@@ -70,6 +75,41 @@ FUNCTIONS = {
         "preset": "str", "resolution": ("int", 8, 512), "thickness": ("real", 0, None),
         "spacing": ("real", 0, None), "jitter": ("real", 0, 0.25), "dilation": ("real", 0, None),
         "groove_direction": "str", "memory_budget": "budget", "seed": "seed", "ctx": "ctx"}),
+    "check_exemplar_pair": (call("check_exemplar_pair", preset="dilate", resolution=8), {
+        "preset": "str", "resolution": ("int", 8, 512), "thickness": ("real", 0, None),
+        "spacing": ("real", 0, None), "jitter": ("real", 0, 0.25), "dilation": ("real", 0, None),
+        "groove_direction": "str", "memory_budget": "budget"}),
+    "min_texture_size": (call("min_texture_size"), {"levels": ("int", 1, 8), "neighborhood": ("int", 3, 32)}),
+    "validate_mesh": (call("validate_mesh", VERTS, FACES), {"name": "str"}),
+    "point_texture_preset": (call("point_texture_preset"), {"name": "str"}),
+    "make_point_exemplar": (lambda **over: _native.make_point_exemplar(**{"name": "bumps", "density": 200.0, **over}), {
+        "name": "str", "density": ("real", 0, None), "padding": ("real", 0, 2), "seed": "seed", "ctx": "ctx"}),
+    "height_field_exemplar": (call("height_field_exemplar", HEIGHTS, padding=2), {
+        "pixel_size": ("real", 0, None), "density": ("real", 0, None), "padding": ("int", 0, 2 ** 20),
+        "seed": "seed", "ctx": "ctx"}),
+    "sample_mesh_points": (call("sample_mesh_points", VERTS, FACES, density=10.0), {
+        "density": ("real", 0, None), "seed": "seed", "memory_budget": "budget", "ctx": "ctx"}),
+    "synthesize_points": (call("synthesize_points", PTS, DIRS), {
+        "memory_budget": "budget", "seed": "seed", "ctx": "ctx"}),
+    "synthesize_points_on_mesh": (call("synthesize_points_on_mesh", PTS, DIRS, VERTS, FACES,
+                                       field=np.zeros_like(VERTS)), {
+        "scale": ("real", 0, None), "memory_budget": "budget", "seed": "seed", "ctx": "ctx"}),
+    "points_to_mesh": (call("points_to_mesh", PTS, DIRS), {
+        "spacing": ("real", None, None), "radius": ("real", 0, None), "voxel": ("real", 0, None),
+        "smoothing": ("int", 0, 64), "memory_budget": "budget", "ctx": "ctx"}),
+    "texture_surface": (call("texture_surface", QUAD_V, QUAD_SIZES, QUAD_FV, IMG, face_resolution=4), {
+        "method": "str", "texels_per_unit": ("real", 0, None), "face_resolution": ("int", 1, 16384),
+        "min_face_resolution": ("int", 1, 16384), "max_face_resolution": ("int", 1, 16384),
+        "exemplar_scale": ("real", 0, None), "coherent_radius": ("int", 1, 5), "coherent_passes": ("int", 1, 8),
+        "levels": ("int", 0, 6), "fine_neighborhood": ("int", 3, 11), "coarse_neighborhood": ("int", 1, 11),
+        "knn": ("int", 1, 64), "knn_tolerance": ("real", 0, None), "pca_variance": ("real", 0, 1),
+        "max_pca_dims": ("int", 1, 4096), "tileable_exemplar": "bool", "memory_budget": "budget", "seed": "seed",
+        "gutter": ("int", 0, 16), "segments": ("int", 1, 64), "displacement_channel": ("int", -1, 15),
+        "displacement_scale": ("real", None, None), "displacement_midlevel": ("real", None, None), "ctx": "ctx"}),
+    "surface_texel_count": (call("surface_texel_count", QUAD_V, QUAD_SIZES, QUAD_FV, face_resolution=4), {
+        "method": "str", "texels_per_unit": ("real", 0, None), "face_resolution": ("int", 1, 16384),
+        "levels": ("int", 0, 6), "memory_budget": "budget", "seed": "seed"}),
+    "surface_limit_points": (call("surface_limit_points", QUAD_V, QUAD_SIZES, QUAD_FV, [0], [[0.5, 0.5]]), {}),
 }
 
 
@@ -190,6 +230,25 @@ ARRAYS = {
         a.get("vertices", VERTS), a.get("faces", FACES), a.get("given", GIVEN)), ["vertices", "faces", "given"]),
     "preset_direction_field": (lambda **a: _native.preset_direction_field(
         a.get("vertices", VERTS), a.get("faces", FACES), axis=a.get("axis", (0, 0, 1))), ["vertices", "faces", "axis"]),
+    "validate_mesh": (lambda **a: _native.validate_mesh(a.get("vertices", VERTS), a.get("faces", FACES)),
+                      ["vertices", "faces"]),
+    "height_field_exemplar": (lambda **a: _native.height_field_exemplar(a.get("heights", HEIGHTS), padding=2),
+                              ["heights"]),
+    "sample_mesh_points": (lambda **a: _native.sample_mesh_points(a.get("vertices", VERTS), a.get("faces", FACES),
+                                                                  density=10.0), ["vertices", "faces"]),
+    "synthesize_points": (lambda **a: _native.synthesize_points(
+        a.get("positions", PTS), a.get("normals", DIRS), box_min=a.get("box_min", (0, 0)),
+        box_max=a.get("box_max", (1, 1)), size=a.get("size", (2, 2))),
+        ["positions", "normals", "box_min", "box_max", "size"]),
+    "points_to_mesh": (lambda **a: _native.points_to_mesh(a.get("positions", PTS), a.get("normals", DIRS)),
+                       ["positions", "normals"]),
+    "texture_surface": (lambda **a: _native.texture_surface(
+        a.get("vertices", QUAD_V), a.get("face_sizes", QUAD_SIZES), a.get("face_vertices", QUAD_FV),
+        a.get("exemplar", IMG), field=a.get("field"), face_resolution=4),
+        ["vertices", "face_sizes", "face_vertices", "exemplar", "field"]),
+    "surface_limit_points": (lambda **a: _native.surface_limit_points(
+        a.get("vertices", QUAD_V), a.get("face_sizes", QUAD_SIZES), a.get("face_vertices", QUAD_FV),
+        a.get("faces", [0]), a.get("uv", [[0.5, 0.5]])), ["vertices", "face_sizes", "face_vertices", "faces", "uv"]),
 }
 NOT_ARRAYS = [("a string", "abc"), ("a dict", {"x": 1}), ("a ragged list", [[1.0, 2.0], [3.0]]),
               ("a list of strings", [["a", "b", "c"]])]

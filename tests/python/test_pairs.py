@@ -89,7 +89,7 @@ def test_bad_input_is_rejected_with_a_message_naming_it(kwargs, exc, words):
 
 
 @pytest.mark.parametrize("preset, options, message", [
-    ("dilate", {"dilation": -5.0}, "'dilation' must be a finite number > 0"),
+    ("dilate", {"dilation": -5.0}, r"'dilation' must be a finite number > 0 \(world units\), got -5"),
     ("spikes", {"feature_height": 5.0}, r"feature_height \(5\) plus half the thickness"),
     ("pits", {"feature_radius": 0.45}, "feature_radius"),
 ])
