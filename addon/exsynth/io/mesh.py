@@ -82,3 +82,24 @@ def mesh_arrays(mesh):
     mesh.loop_triangles.foreach_get("vertices", tris)
     return co.reshape(-1, 3), tris.reshape(-1, 3)
 
+
+
+def selected_world_triangles(obj):
+    """World-space (vertices V by 3 float64, triangles F by 3) of the faces
+    selected on a mesh object's own mesh (as last left in Edit Mode), or
+    None when no face is selected."""
+    mesh = obj.data
+    selected = np.zeros(len(mesh.polygons), bool)
+    mesh.polygons.foreach_get("select", selected)
+    if not selected.any():
+        return None
+    mesh.calc_loop_triangles()
+    tris = np.zeros(3 * len(mesh.loop_triangles), np.int32)
+    mesh.loop_triangles.foreach_get("vertices", tris)
+    owner = np.zeros(len(mesh.loop_triangles), np.int32)
+    mesh.loop_triangles.foreach_get("polygon_index", owner)
+    co = np.zeros(3 * len(mesh.vertices), np.float32)
+    mesh.vertices.foreach_get("co", co)
+    matrix = np.array(obj.matrix_world, np.float64)
+    verts = co.reshape(-1, 3).astype(np.float64) @ matrix[:3, :3].T + matrix[:3, 3]
+    return verts, tris.reshape(-1, 3)[selected[owner]]

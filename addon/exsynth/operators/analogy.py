@@ -417,24 +417,13 @@ def mesh_input(context, settings, obj, role, fix, with_field=True):
 def selected_faces(obj):
     """World-space triangles of the faces selected on a mesh object (its
     own mesh, as last left in Edit Mode), or an InputError."""
-    mesh = obj.data
-    selected = np.zeros(len(mesh.polygons), bool)
-    mesh.polygons.foreach_get("select", selected)
-    if not selected.any():
+    faces = mesh_io.selected_world_triangles(obj)
+    if faces is None:
         raise InputError(
             f"no faces of A '{obj.name}' are selected. Select the faces whose change A′ shows (Tab into "
             "Edit Mode, face select, then Tab back), or untick Selected Faces of A"
         )
-    mesh.calc_loop_triangles()
-    tris = np.zeros(3 * len(mesh.loop_triangles), np.int32)
-    mesh.loop_triangles.foreach_get("vertices", tris)
-    owner = np.zeros(len(mesh.loop_triangles), np.int32)
-    mesh.loop_triangles.foreach_get("polygon_index", owner)
-    co = np.zeros(3 * len(mesh.vertices), np.float32)
-    mesh.vertices.foreach_get("co", co)
-    matrix = np.array(obj.matrix_world, np.float64)
-    verts = co.reshape(-1, 3).astype(np.float64) @ matrix[:3, :3].T + matrix[:3, 3]
-    return verts, tris.reshape(-1, 3)[selected[owner]]
+    return faces
 
 
 def user_pair(context, settings, b):

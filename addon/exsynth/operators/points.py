@@ -152,22 +152,11 @@ def object_exemplar(context, obj, selected_only, density):
     if obj is None or obj.type != 'MESH':
         raise InputError("pick a mesh object as the exemplar (Exemplar > Object), or choose a built-in")
     if selected_only:
-        mesh = obj.data
-        sel = np.zeros(len(mesh.polygons), bool)
-        mesh.polygons.foreach_get("select", sel)
-        if not sel.any():
+        faces = mesh_io.selected_world_triangles(obj)
+        if faces is None:
             raise InputError(f"no faces of '{obj.name}' are selected. Select the faces to learn from (Tab into "
                              "Edit Mode, face select, Tab back), or choose Exemplar: Object")
-        mesh.calc_loop_triangles()
-        tris = np.zeros(3 * len(mesh.loop_triangles), np.int32)
-        mesh.loop_triangles.foreach_get("vertices", tris)
-        owner = np.zeros(len(mesh.loop_triangles), np.int32)
-        mesh.loop_triangles.foreach_get("polygon_index", owner)
-        co = np.zeros(3 * len(mesh.vertices), np.float32)
-        mesh.vertices.foreach_get("co", co)
-        m = np.array(obj.matrix_world, np.float64)
-        verts = co.reshape(-1, 3).astype(np.float64) @ m[:3, :3].T + m[:3, 3]
-        tris = tris.reshape(-1, 3)[sel[owner]]
+        verts, tris = faces
     else:
         verts, tris = mesh_io.world_triangles([obj], context.evaluated_depsgraph_get())
     if len(tris) == 0:
