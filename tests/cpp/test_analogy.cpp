@@ -16,6 +16,7 @@
 #include "exsynth/errors.hpp"
 #include "exsynth/pairs.hpp"
 #include "exsynth/rng.hpp"
+#include "support/volumes.hpp"
 
 using namespace exsynth;
 using ::testing::HasSubstr;
@@ -179,19 +180,8 @@ GridTransform centred(int n, double h) {
 }
 
 // Circles around the z axis: the field of the grooves pair, for any grid
-// centred on the origin.
-Volume around_z(const Volume& like) {
-  Volume f(like.nx(), like.ny(), like.nz(), 3, 0.0f, like.transform());
-  for (int z = 0; z < f.nz(); ++z)
-    for (int y = 0; y < f.ny(); ++y)
-      for (int x = 0; x < f.nx(); ++x) {
-        const auto p = f.transform().index_to_world(x, y, z);
-        const double r = std::hypot(p[0], p[1]);
-        f.at(x, y, z, 0) = float(r > 1e-9 ? -p[1] / r : 1.0);
-        f.at(x, y, z, 1) = float(r > 1e-9 ? p[0] / r : 0.0);
-      }
-  return f;
-}
+// centred on the origin (support/volumes.hpp).
+Volume around_z(const Volume& like) { return exsynth::testing::around_z_field(like); }
 
 // Connected parts (6-neighbours) of the inside (sdf < 0) or the outside.
 int components(const Volume& v, bool inside) {

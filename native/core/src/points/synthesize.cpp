@@ -94,6 +94,19 @@ void finish_density(PointTextureResult& r, const PointExemplar& ex) {
   r.density = double(inside) / ((ex.box_max.x() - ex.box_min.x()) * (ex.box_max.y() - ex.box_min.y()));
 }
 
+// The solver's counters and stage times into the result; "other" is the
+// whole call's time not in search, warp or blend.
+PointTextureResult with_stats(PointTextureResult result, const PointTextureResult& st, Clock::time_point t_start) {
+  result.patches = st.patches;
+  result.pairs = st.pairs;
+  result.fallbacks = st.fallbacks;
+  result.spacing = st.spacing;
+  result.times = st.times;
+  const double total = std::chrono::duration<double>(Clock::now() - t_start).count();
+  result.times.other = std::max(0.0, total - result.times.search - result.times.warp - result.times.blend);
+  return result;
+}
+
 }  // namespace
 
 PointTextureResult synthesize_points(const PointExemplar& exemplar, double width, double depth,
@@ -136,15 +149,7 @@ PointTextureResult synthesize_points(const PointExemplar& exemplar, double width
       result.points.normals.push_back(alive.normals[i]);
     }
   }
-  const PointTextureResult& st = solver.stats();
-  result.patches = st.patches;
-  result.pairs = st.pairs;
-  result.fallbacks = st.fallbacks;
-  result.spacing = st.spacing;
-  result.times = st.times;
-  const double total = std::chrono::duration<double>(Clock::now() - t_start).count();
-  result.times.other = std::max(0.0, total - result.times.search - result.times.warp - result.times.blend);
-  return result;
+  return with_stats(std::move(result), solver.stats(), t_start);
 }
 
 namespace {
@@ -255,15 +260,7 @@ PointTextureResult synthesize_points_on_mesh(const PointExemplar& exemplar, cons
       alive.normals.push_back(out.normals[i]);
     }
   result.points = relax(std::move(alive), solver.spacing() * scale, opt.relax_iterations, ctx);
-  const PointTextureResult& st = solver.stats();
-  result.patches = st.patches;
-  result.pairs = st.pairs;
-  result.fallbacks = st.fallbacks;
-  result.spacing = st.spacing;
-  result.times = st.times;
-  const double total = std::chrono::duration<double>(Clock::now() - t_start).count();
-  result.times.other = std::max(0.0, total - result.times.search - result.times.warp - result.times.blend);
-  return result;
+  return with_stats(std::move(result), solver.stats(), t_start);
 }
 
 }  // namespace exsynth
