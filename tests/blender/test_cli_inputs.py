@@ -173,3 +173,31 @@ def test_texture_sizes_follow_the_engine_rule_by_option_name(tmp_path, monkeypat
     code, err = run(capsys, args[0], "--exemplar", os.path.join(TEXTURES, "crackedground.png"), *args[1:])
     assert code == 2 and message in err and "voxels across" not in err
     assert os.listdir(tmp_path) == []
+
+
+def huge_exr(path, magnitude=1e20, size=40):
+    """A 32-bit float EXR whose values are ~magnitude (a half-float EXR would
+    hold inf: Blender saves 16-bit unless the scene's settings say 32)."""
+    image = bpy.data.images.new("huge", size, size, float_buffer=True)
+    px = np.ones((size, size, 4), np.float32)
+    px[..., :3] = np.random.default_rng(1).random((size, size, 3)) * magnitude
+    image.pixels.foreach_set(px.ravel())
+    settings = bpy.context.scene.render.image_settings
+    old = settings.file_format, settings.color_depth
+    settings.file_format, settings.color_depth = "OPEN_EXR", "32"
+    try:
+        image.save_render(str(path), scene=bpy.context.scene)
+    finally:
+        settings.file_format, settings.color_depth = old
+        bpy.data.images.remove(image)
+    return str(path)
+
+
+def test_an_exemplar_of_1e20_gives_finite_values_of_its_size(tmp_path, capsys):
+    exr = huge_exr(tmp_path / "huge.exr")
+    code, err = run(capsys, "solid", "--exemplar", exr, "--size", "32", "--out", str(tmp_path / "s.npy"))
+    assert code == 0, err
+    assert "nan" not in err.lower() and "inf" not in err.lower()
+    values = np.load(tmp_path / "s.npy")
+    assert np.isfinite(values).all()
+    assert 1e19 < np.median(values) < 1e20 and np.ptp(values) > 1e19

@@ -57,6 +57,13 @@ class Volume {
   Volume(int nx, int ny, int nz, int channels, float fill = 0.0f, GridTransform xform = {})
       : nx_(nx), ny_(ny), nz_(nz), channels_(channels), xform_(xform),
         data_(std::size_t(nx) * ny * nz * channels, fill) {}
+  /// Adopts `values` (nx*ny*nz*channels floats, x fastest) without a copy or
+  /// a zero fill: a 384^3 fill alone kept a stage from its cancel checks
+  /// for ~0.2 s.
+  Volume(int nx, int ny, int nz, int channels, std::vector<float>&& values, GridTransform xform)
+      : nx_(nx), ny_(ny), nz_(nz), channels_(channels), xform_(xform), data_(std::move(values)) {
+    data_.resize(std::size_t(nx) * ny * nz * channels);
+  }
 
   int nx() const { return nx_; }
   int ny() const { return ny_; }

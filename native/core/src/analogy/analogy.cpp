@@ -326,13 +326,12 @@ AnalogyResult run(const Volume& a, const Volume& a_prime, const Volume* field_a,
     std::iota(order.begin(), order.end(), 0u);
     if (aligned) {
       const int iterations = has_coarser ? 40 : 400;
+      StageProgress start(ctx, stage + " sweep distance", share(0.14), share(0.14), band.size());
+      std::vector<float> phi_start = upsample_phi(phi_coarse, has_phi_coarse, bl, band, start);
       StageProgress sweep(ctx, stage + " sweep distance", share(0.14), share(0.17), std::size_t(iterations) + 1);
       const std::vector<float> phi =
-          analogy::sweep_distance(bl.nx(), bl.ny(), bl.nz(), band, b_frames,
-                                  upsample_phi(phi_coarse, has_phi_coarse, bl, band), iterations, sweep);
-      sweep.check();
-      std::stable_sort(order.begin(), order.end(), [&](std::uint32_t i, std::uint32_t j) { return phi[i] < phi[j]; });
-      sweep.check();
+          analogy::sweep_distance(bl.nx(), bl.ny(), bl.nz(), band, b_frames, std::move(phi_start), iterations, sweep);
+      order = analogy::sorted_by(phi, sweep);
       phi_coarse = Volume(bl.nx(), bl.ny(), bl.nz(), 1);
       has_phi_coarse = Volume(bl.nx(), bl.ny(), bl.nz(), 1);
       for (std::size_t i = 0; i < band.size(); ++i) {

@@ -3,6 +3,10 @@
 #include "analogy/features.hpp"
 #include "exsynth/parallel.hpp"
 
+#include <cstring>
+
+#include <tbb/parallel_sort.h>
+
 namespace exsynth::analogy {
 
 std::vector<std::uint32_t> breadth_first(const Volume& grid, const std::vector<std::uint32_t>& band,
@@ -46,15 +50,39 @@ Volume upsample(const Volume& coarse, const Volume& like, StageProgress& progres
 }
 
 std::vector<float> upsample_phi(const Volume& phi_coarse, const Volume& has_coarse, const Volume& level,
-                                const std::vector<std::uint32_t>& voxels) {
+                                const std::vector<std::uint32_t>& voxels, StageProgress& progress) {
   if (phi_coarse.empty()) return {};
   std::vector<float> out(voxels.size(), 0.0f);
-  for (std::size_t i = 0; i < voxels.size(); ++i) {
-    const Vec3 g = 0.5f * voxel_position(level, voxels[i]);
-    const float w = trilinear(has_coarse, g.x(), g.y(), g.z());
-    out[i] = w > 1e-6f ? 2.0f * trilinear(phi_coarse, g.x(), g.y(), g.z()) / w : 0.0f;
-  }
+  parallel_chunks(voxels.size(), 1 << 14, progress, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t i = begin; i < end; ++i) {
+      const Vec3 g = 0.5f * voxel_position(level, voxels[i]);
+      const float w = trilinear(has_coarse, g.x(), g.y(), g.z());
+      out[i] = w > 1e-6f ? 2.0f * trilinear(phi_coarse, g.x(), g.y(), g.z()) / w : 0.0f;
+    }
+  });
   return out;
+}
+
+std::vector<std::uint32_t> sorted_by(const std::vector<float>& key, const StageProgress& progress) {
+  // Float bits made to order as unsigned integers (negatives flipped), the
+  // position in the low half: every pair is distinct, so any sort gives the
+  // one stable order whatever the thread count.
+  std::vector<std::uint64_t> pairs(key.size());
+  for (std::size_t i = 0; i < key.size(); ++i) {
+    progress.check_every(i);
+    std::uint32_t bits;
+    std::memcpy(&bits, &key[i], sizeof bits);
+    bits = (bits & 0x80000000u) ? ~bits : (bits | 0x80000000u);
+    pairs[i] = (std::uint64_t(bits) << 32) | std::uint32_t(i);
+  }
+  tbb::parallel_sort(pairs.begin(), pairs.end(), [&progress](std::uint64_t a, std::uint64_t b) {
+    thread_local std::uint32_t calls = 0;  // a check per ~10^6 comparisons and thread
+    if ((++calls & 0xFFFFF) == 0) progress.check();
+    return a < b;
+  });
+  std::vector<std::uint32_t> order(key.size());
+  for (std::size_t i = 0; i < key.size(); ++i) order[i] = std::uint32_t(pairs[i]);
+  return order;
 }
 
 }  // namespace exsynth::analogy

@@ -23,6 +23,11 @@ Volume upsample(const Volume& coarse, const Volume& like, StageProgress& progres
 // units halve), averaged over the coarse corners that have one; empty when
 // there is no coarser level.
 std::vector<float> upsample_phi(const Volume& phi_coarse, const Volume& has_coarse, const Volume& level,
-                                const std::vector<std::uint32_t>& voxels);
+                                const std::vector<std::uint32_t>& voxels, StageProgress& progress);
+
+// The band's positions (0..n-1) in increasing `key`, ties by position: a
+// stable sort, on (key, position) pairs in parallel and checking for a
+// cancel (std::stable_sort of 10^6 indices took ~0.2 s without one).
+std::vector<std::uint32_t> sorted_by(const std::vector<float>& key, const StageProgress& progress);
 
 }  // namespace exsynth::analogy

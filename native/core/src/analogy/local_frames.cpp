@@ -1,6 +1,7 @@
 #include "analogy/local_frames.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 
 #include <Eigen/Geometry>
@@ -84,35 +85,43 @@ std::vector<float> sweep_distance(int nx, int ny, int nz, const std::vector<std:
   };
   // Least squares over the edges (i, j) to the +x, +y, +z neighbours:
   // phi_j - phi_i = mean T along the edge. Normal equations: a graph
-  // Laplacian; a tiny diagonal fixes each component's free constant.
-  std::vector<Eigen::Triplet<double>> triplets;
-  triplets.reserve(n * 7);
-  Eigen::VectorXd rhs = Eigen::VectorXd::Zero(Eigen::Index(n));
+  // Laplacian (degree on the diagonal, -1 per neighbour); a tiny diagonal
+  // fixes each component's free constant. Rows are written in column order
+  // straight into the compressed matrix: Eigen's setFromTriplets on 7n
+  // triplets took ~0.2 s at 10^6 voxels with no cancel check inside.
   const std::uint32_t step[3] = {1u, std::uint32_t(nx), std::uint32_t(nx) * std::uint32_t(ny)};
+  const int dims[3] = {nx, ny, nz};
+  Eigen::SparseMatrix<double, Eigen::RowMajor> lap{Eigen::Index(n), Eigen::Index(n)};
+  lap.reserve(Eigen::VectorXi::Constant(Eigen::Index(n), 7));
+  Eigen::VectorXd rhs = Eigen::VectorXd::Zero(Eigen::Index(n));
   for (std::size_t i = 0; i < n; ++i) {
     progress.check_every(i);
     const std::uint32_t v = voxels[i];
     const int c[3] = {int(v % std::uint32_t(nx)), int((v / std::uint32_t(nx)) % std::uint32_t(ny)),
                       int(v / (std::uint32_t(nx) * std::uint32_t(ny)))};
-    const int dims[3] = {nx, ny, nz};
-    triplets.emplace_back(Eigen::Index(i), Eigen::Index(i), 1e-6);
+    std::array<std::ptrdiff_t, 6> nb;  // rows of the -z -y -x +x +y +z neighbours, -1 = none
     for (int a = 0; a < 3; ++a) {
-      if (c[a] + 1 >= dims[a]) continue;
-      const std::ptrdiff_t j = row_of(v + step[a]);
+      nb[std::size_t(2 - a)] = c[a] > 0 ? row_of(v - step[a]) : -1;
+      nb[std::size_t(3 + a)] = c[a] + 1 < dims[a] ? row_of(v + step[a]) : -1;
+    }
+    int degree = 0;
+    for (const std::ptrdiff_t j : nb) degree += j >= 0;
+    for (int k = 0; k < 3; ++k)
+      if (nb[std::size_t(k)] >= 0) lap.insert(Eigen::Index(i), Eigen::Index(nb[std::size_t(k)])) = -1.0;
+    lap.insert(Eigen::Index(i), Eigen::Index(i)) = 1e-6 + degree;
+    for (int k = 3; k < 6; ++k)
+      if (nb[std::size_t(k)] >= 0) lap.insert(Eigen::Index(i), Eigen::Index(nb[std::size_t(k)])) = -1.0;
+    for (int a = 0; a < 3; ++a) {
+      const std::ptrdiff_t j = nb[std::size_t(3 + a)];
       if (j < 0) continue;
       const double d = 0.5 * double(frames[i](a, 0) + frames[std::size_t(j)](a, 0));
-      triplets.emplace_back(Eigen::Index(i), Eigen::Index(i), 1.0);
-      triplets.emplace_back(Eigen::Index(j), Eigen::Index(j), 1.0);
-      triplets.emplace_back(Eigen::Index(i), Eigen::Index(j), -1.0);
-      triplets.emplace_back(Eigen::Index(j), Eigen::Index(i), -1.0);
       rhs[Eigen::Index(i)] -= d;
       rhs[Eigen::Index(j)] += d;
     }
   }
-  Eigen::SparseMatrix<double> lap{Eigen::Index(n), Eigen::Index(n)};
-  lap.setFromTriplets(triplets.begin(), triplets.end());
+  lap.makeCompressed();
   progress.check();
-  Eigen::ConjugateGradient<Eigen::SparseMatrix<double>, Eigen::Lower | Eigen::Upper, CancellablePreconditioner> cg;
+  Eigen::ConjugateGradient<Eigen::SparseMatrix<double, Eigen::RowMajor>, Eigen::Lower | Eigen::Upper, CancellablePreconditioner> cg;
   cg.setMaxIterations(iterations);
   cg.setTolerance(1e-5);
   cg.compute(lap);

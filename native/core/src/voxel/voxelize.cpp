@@ -31,8 +31,8 @@ void validate_options(const VoxelizeOptions& opt) {
 }
 
 // Peak bytes: three coverage volumes + votes + density while stabbing;
-// density + votes + squared distance + labels + sdf afterwards: 17 per voxel
-// either way (21 for a moment while the density is blended), plus the mesh copies (index-space vertices, Embree's BVH).
+// density + votes + squared distance (turned into the sdf in place) + labels
+// afterwards: 17 and 13 per voxel (21 for a moment while the density is blended), plus the mesh copies (index-space vertices, Embree's BVH).
 double estimate_bytes(const VoxelGridSpec& g, const TriangleMesh& mesh) {
   const double voxels = double(g.nx) * g.ny * g.nz;
   return voxels * 21.0 + double(mesh.faces.size()) * 96.0 + double(mesh.vertices.size()) * 32.0;
@@ -205,10 +205,11 @@ VoxelizeResult voxelize(const TriangleMesh& input, const VoxelizeOptions& opt, E
     StageProgress edt(ctx, "voxelize: distance transform", 0.65, 0.85, lines);
     voxel::distance_transform(g.nx, g.ny, g.nz, dist2, label, edt);
   }
-  result.sdf = Volume(g.nx, g.ny, g.nz, 1, 0.0f, g.transform);
   {
+    // Signed distances overwrite the squared ones in place (each voxel reads
+    // only its own), and the buffer becomes the volume.
     StageProgress exact(ctx, "voxelize: exact distances", 0.85, 1.0, voxels);
-    float* s = result.sdf.data();
+    float* s = dist2.data();
     const float h = float(g.transform.voxel_size);
     parallel_chunks(voxels, 1 << 14, exact, [&](std::size_t begin, std::size_t end) {
       for (std::size_t v = begin; v < end; ++v) {
@@ -223,6 +224,7 @@ VoxelizeResult voxelize(const TriangleMesh& input, const VoxelizeOptions& opt, E
         s[v] = votes[v] >= 2 ? -d : d;
       }
     });
+    result.sdf = Volume(g.nx, g.ny, g.nz, 1, std::move(dist2), g.transform);
   }
   if (ctx) ctx->set_progress(1.0);
   return result;

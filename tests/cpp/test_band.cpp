@@ -1,0 +1,68 @@
+// The analogy's band helpers against brute-force references.
+#include <gtest/gtest.h>
+#include <tbb/global_control.h>
+
+#include <algorithm>
+#include <numeric>
+#include <random>
+#include <vector>
+
+#include "analogy/band.hpp"
+#include "exsynth/errors.hpp"
+
+using namespace exsynth;
+
+namespace {
+
+std::vector<std::uint32_t> stable_reference(const std::vector<float>& key) {
+  std::vector<std::uint32_t> order(key.size());
+  std::iota(order.begin(), order.end(), 0u);
+  std::stable_sort(order.begin(), order.end(), [&](std::uint32_t i, std::uint32_t j) { return key[i] < key[j]; });
+  return order;
+}
+
+std::vector<float> keys_with_ties(std::size_t n, unsigned seed) {
+  std::mt19937 rng(seed);
+  std::uniform_int_distribution<int> value(-50, 50);  // many ties, both signs, and +-0
+  std::vector<float> key(n);
+  for (float& k : key) k = float(value(rng)) * 0.25f;
+  key[0] = -0.0f;
+  key[1] = 0.0f;
+  key[2] = -1e30f;
+  key[3] = 1e30f;
+  return key;
+}
+
+}  // namespace
+
+TEST(SortedBy, IsTheStableSortOfTheKeys) {
+  const StageProgress none(nullptr, "", 0, 1, 1);
+  for (std::size_t n : {std::size_t(4), std::size_t(1000), std::size_t(200000)}) {
+    const std::vector<float> key = keys_with_ties(n, unsigned(n));
+    EXPECT_EQ(analogy::sorted_by(key, none), stable_reference(key)) << n << " keys";
+  }
+}
+
+TEST(SortedBy, SameOrderWhateverTheThreadCount) {
+  const StageProgress none(nullptr, "", 0, 1, 1);
+  const std::vector<float> key = keys_with_ties(300000, 5);
+  std::vector<std::uint32_t> one, eight;
+  {
+    tbb::global_control c(tbb::global_control::max_allowed_parallelism, 1);
+    one = analogy::sorted_by(key, none);
+  }
+  {
+    tbb::global_control c(tbb::global_control::max_allowed_parallelism, 8);
+    eight = analogy::sorted_by(key, none);
+  }
+  EXPECT_EQ(one, eight);
+}
+
+TEST(SortedBy, ACancelStopsIt) {
+  ExecContext ctx;
+  const StageProgress progress(&ctx, "sort", 0, 1, 1);
+  const std::vector<float> key = keys_with_ties(1000, 3);
+  EXPECT_NO_THROW(analogy::sorted_by(key, progress));
+  ctx.cancel();
+  EXPECT_THROW(analogy::sorted_by(key, progress), Cancelled);
+}
