@@ -101,6 +101,31 @@ TEST(PointSurface, ProjectionConvergesOntoSphereAndPlane) {
   }
 }
 
+TEST(PointSurface, ProjectionWithOneQueryEqualsStepsOfFreshEvaluations) {
+  // project() reuses one wider radius query while it stays near its start;
+  // the reference re-evaluates from scratch (a fresh k-d tree query) each step.
+  const OrientedPoints sphere = sphere_points(1.0f, 3000);
+  const float h = 0.08f;
+  const points::PointSurface s(sphere.positions, sphere.normals, h);
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<float> u(-1, 1), rr(0.85f, 1.15f);  // most starts farther than the slack (h / 2)
+  for (int k = 0; k < 100; ++k) {
+    const V3 x0 = rr(rng) * V3(u(rng), u(rng), u(rng)).normalized();
+    V3 x = x0;
+    points::Projection ref;
+    for (int it = 0; it < 5; ++it) {
+      const points::SurfaceSample e = s.evaluate(x);
+      ASSERT_TRUE(e.valid);
+      x -= e.f * e.normal;
+      ref.point = x;
+    }
+    ref.normal = s.evaluate(x).normal;  // not converged (tol 0): the normal where it ends
+    const points::Projection p = s.project(x0, 5, 0.0f);
+    EXPECT_LT((p.point - ref.point).norm(), 1e-5f) << "start " << x0.transpose();
+    EXPECT_GT(p.normal.dot(ref.normal), 1 - 1e-5f);
+  }
+}
+
 TEST(PointSurface, MatchesBruteForceAndExactSphereField) {
   const OrientedPoints sphere = sphere_points(1.0f, 3000);
   const float h = 0.08f;
@@ -144,6 +169,9 @@ TEST(ThinPlateSpline, InterpolatesPairsAndJacobianNormalsMatchFiniteDifferences)
     const Eigen::Vector3d d2 = tps.apply(x + e * t2) - tps.apply(x - e * t2);
     const Eigen::Vector3d fd = d1.cross(d2).normalized();  // the warped tangent plane's normal
     EXPECT_GT(tps.transform_normal(x, n).dot(fd), 1 - 1e-6);
+    Eigen::Vector3d n1;  // the vectorised form gives the reference's point and normal
+    EXPECT_LT((tps.apply(x, n, n1) - tps.apply(x)).norm(), 1e-12);  // only the summation order differs
+    EXPECT_LT((n1 - tps.transform_normal(x, n)).norm(), 1e-12);
   }
 }
 

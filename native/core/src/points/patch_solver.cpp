@@ -246,9 +246,10 @@ void PatchSolver::warp(std::vector<LocalPoint>& src, const std::vector<float>& s
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, src.size(), 512), [&](const auto& rg) {
     for (std::size_t i = rg.begin(); i < rg.end(); ++i) {
       const Eigen::Vector3d x = src[i].p.cast<double>();
-      const Eigen::Vector3d y = tps.apply(x);
+      Eigen::Vector3d n;
+      const Eigen::Vector3d y = tps.apply(x, src[i].n.cast<double>(), n);
       if ((y - x).norm() > 0.5 * patch_) wild = true;
-      warped[i] = {y.cast<float>(), tps.transform_normal(x, src[i].n.cast<double>()).cast<float>()};
+      warped[i] = {y.cast<float>(), n.cast<float>()};
     }
   });
   if (wild) return;  // contradictory pairs fold the spline: keep the patch as it is
@@ -316,8 +317,10 @@ void PatchSolver::blend(std::vector<LocalPoint>& fresh, std::vector<char>& keep_
     if (surface.nearest(pt.p, &d2) >= surface.size() || d2 > max_move * max_move) return;  // nothing to meet
     const float alpha = 1.0f - std::pow(1.0f - std::min(w, 0.999f), 1.0f / float(iters));
     const Eigen::Vector3f start = pt.p;
+    thread_local PointSurface::Cursor cursor;  // one neighbour query for all the steps, mostly
+    cursor.centre = Eigen::Vector3f::Constant(std::numeric_limits<float>::infinity());
     for (int k = 0; k < iters; ++k) {
-      Projection pr = surface.project(pt.p, 3, float(1e-2 * h_));
+      Projection pr = surface.project(pt.p, 3, float(1e-2 * h_), &cursor);
       if (!pr.converged || (pr.point - start).norm() > max_move) {
         Eigen::Vector3f hit, hit_n;
         if (!two_ray_hit(surface, pt.p, pt.n, ray_reach, float(h_), hit, hit_n)) return;

@@ -5,7 +5,9 @@
 // x <- x - f(x) n(x) (their quasi-orthogonal projection). Built once over a
 // point set, queried from many threads (queries are const).
 #include <cstddef>
+#include <limits>
 #include <memory>
+#include <utility>
 #include <vector>
 
 #include <Eigen/Core>
@@ -33,8 +35,18 @@ class PointSurface {
   PointSurface(const std::vector<Eigen::Vector3f>& positions, const std::vector<Eigen::Vector3f>& normals, float h);
 
   SurfaceSample evaluate(const Eigen::Vector3f& x) const;
-  /// At most `iterations` steps; converged when a step is below tol.
-  Projection project(const Eigen::Vector3f& x, int iterations = 8, float tol = 1e-5f) const;
+  /// The neighbours of a moving query point: one radius query of the cut-off
+  /// plus a slack serves every evaluation within the slack of its centre.
+  struct Cursor {
+    Eigen::Vector3f centre = Eigen::Vector3f::Constant(std::numeric_limits<float>::infinity());
+    std::vector<std::pair<std::size_t, float>> wide, near;
+  };
+  /// As evaluate(x), through the cursor (same neighbours, same result up to
+  /// the order of the sums).
+  SurfaceSample evaluate(const Eigen::Vector3f& x, Cursor& cursor) const;
+  /// At most `iterations` steps; converged when a step is below tol. Pass a
+  /// cursor to share its query across calls from nearby points.
+  Projection project(const Eigen::Vector3f& x, int iterations = 8, float tol = 1e-5f, Cursor* cursor = nullptr) const;
   /// Nearest point's index (size() when empty) and squared distance.
   std::size_t nearest(const Eigen::Vector3f& x, float* d2 = nullptr) const;
   const search::PointIndex& index() const { return index_; }
@@ -42,6 +54,9 @@ class PointSurface {
   std::size_t size() const { return positions_.size(); }
 
  private:
+  static constexpr float kCutoff = 2.5f;  ///< neighbours within 2.5 h (weights below 0.2 % beyond)
+  SurfaceSample weighted(const Eigen::Vector3f& x, const std::vector<std::pair<std::size_t, float>>& near) const;
+
   const std::vector<Eigen::Vector3f>& positions_;
   const std::vector<Eigen::Vector3f>& normals_;
   float h_;

@@ -87,6 +87,17 @@ OrientedPoints relax(OrientedPoints pts, double spacing, int rounds, ExecContext
   return pts;
 }
 
+// The output's points that no later patch replaced, in the order they were added.
+OrientedPoints alive_points(const points::OutputStore& out) {
+  OrientedPoints alive;
+  for (std::size_t i = 0; i < out.positions.size(); ++i)
+    if (out.alive[i]) {
+      alive.positions.push_back(out.positions[i]);
+      alive.normals.push_back(out.normals[i]);
+    }
+  return alive;
+}
+
 void finish_density(PointTextureResult& r, const PointExemplar& ex) {
   std::size_t inside = 0;
   for (const auto& p : ex.points.positions)
@@ -134,12 +145,7 @@ PointTextureResult synthesize_points(const PointExemplar& exemplar, double width
         progress.advance();
       }
   }
-  OrientedPoints alive;
-  for (std::size_t i = 0; i < out.positions.size(); ++i)
-    if (out.alive[i]) {
-      alive.positions.push_back(out.positions[i]);
-      alive.normals.push_back(out.normals[i]);
-    }
+  OrientedPoints alive = alive_points(out);
   // Relax with the border strip still there (whole neighbourhoods), then crop it.
   alive = relax(std::move(alive), solver.spacing(), opt.relax_iterations, ctx);
   for (std::size_t i = 0; i < alive.size(); ++i) {
@@ -253,12 +259,7 @@ PointTextureResult synthesize_points_on_mesh(const PointExemplar& exemplar, cons
       progress.advance();
     }
   }
-  OrientedPoints alive;
-  for (std::size_t i = 0; i < out.positions.size(); ++i)
-    if (out.alive[i]) {
-      alive.positions.push_back(out.positions[i]);
-      alive.normals.push_back(out.normals[i]);
-    }
+  OrientedPoints alive = alive_points(out);
   result.points = relax(std::move(alive), solver.spacing() * scale, opt.relax_iterations, ctx);
   return with_stats(std::move(result), solver.stats(), t_start);
 }

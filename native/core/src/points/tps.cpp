@@ -33,6 +33,9 @@ ThinPlateSpline::ThinPlateSpline(const std::vector<Eigen::Vector3d>& sources,
   centres_ = sources;
   weights_.resize(std::size_t(n));
   for (int i = 0; i < n; ++i) weights_[std::size_t(i)] = sol.row(i).transpose();
+  centre_columns_.resize(n, 3);
+  weight_columns_ = sol.topRows(n);
+  for (int i = 0; i < n; ++i) centre_columns_.row(i) = sources[std::size_t(i)].transpose();
   linear_ = sol.block(n, 0, 3, 3).transpose();
   offset_ = sol.row(n + 3).transpose();
 }
@@ -53,14 +56,38 @@ Eigen::Matrix3d ThinPlateSpline::jacobian(const Eigen::Vector3d& x) const {
   return j;
 }
 
-Eigen::Vector3d ThinPlateSpline::transform_normal(const Eigen::Vector3d& x, const Eigen::Vector3d& n) const {
-  const Eigen::Matrix3d j = jacobian(x);
+namespace {
+
+// J^-T n normalised; n itself where J is singular.
+Eigen::Vector3d normal_through(const Eigen::Matrix3d& j, const Eigen::Vector3d& n) {
   const double det = j.determinant();
   if (!(std::abs(det) > 1e-12)) return n;
-  // J^-T n = cof(J) n / det; the sign of det keeps the orientation.
-  Eigen::Vector3d m = j.inverse().transpose() * n;
+  const Eigen::Vector3d m = j.inverse().transpose() * n;
   const double len = m.norm();
   return len > 0 ? Eigen::Vector3d(m / len) : n;
+}
+
+}  // namespace
+
+Eigen::Vector3d ThinPlateSpline::transform_normal(const Eigen::Vector3d& x, const Eigen::Vector3d& n) const {
+  return normal_through(jacobian(x), n);
+}
+
+Eigen::Vector3d ThinPlateSpline::apply(const Eigen::Vector3d& x, const Eigen::Vector3d& n, Eigen::Vector3d& n_out) const {
+  thread_local Eigen::ArrayXd d[3], r, inv, w_inv;  // no allocation per point
+  for (int a = 0; a < 3; ++a) d[a] = x[a] - centre_columns_.col(a).array();
+  r = (d[0].square() + d[1].square() + d[2].square()).sqrt();
+  inv = (r > 1e-12).select(r.inverse(), 0.0);  // a centre at x adds nothing to J (as in jacobian())
+  Eigen::Vector3d y = linear_ * x + offset_;
+  Eigen::Matrix3d j = linear_;
+  for (int a = 0; a < 3; ++a) {
+    const auto w = weight_columns_.col(a).array();
+    y[a] += (w * r).sum();
+    w_inv = w * inv;
+    for (int b = 0; b < 3; ++b) j(a, b) += (w_inv * d[b]).sum();
+  }
+  n_out = normal_through(j, n);
+  return y;
 }
 
 }  // namespace exsynth::points
