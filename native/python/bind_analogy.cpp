@@ -1,4 +1,4 @@
-// exsynth._native.synthesize_analogy
+// exsynth._native.synthesize_analogy, analogy_padding
 #include <pybind11/pybind11.h>
 
 #include "arguments.hpp"
@@ -11,6 +11,17 @@ namespace py = pybind11;
 namespace exsynth::py_bind {
 
 void bind_analogy(py::module_& m) {
+  m.def(
+      "analogy_padding",
+      [](const IntArg& fine_size, const IntArg& coarse_size, const py::kwargs& extra) {
+        reject_unknown(extra, "fine_size, coarse_size");
+        using Lim = AnalogyLimits;
+        return analogy_padding(int_arg(fine_size, "fine_size", Lim::min_fine_size, Lim::max_fine_size),
+                               int_arg(coarse_size, "coarse_size", Lim::min_coarse_size, Lim::max_coarse_size));
+      },
+      py::arg("fine_size") = AnalogyOptions{}.fine_size, py::arg("coarse_size") = AnalogyOptions{}.coarse_size,
+      "Empty voxels a grid needs around a surface for the analogy's neighbourhoods (fine half-width plus the "
+      "coarse one at half resolution; 4 by default): voxelize A, A' and B with at least this padding.");
   m.def(
       "synthesize_analogy",
       [](const ArrayArg& a_arg, const ArrayArg& a_prime_arg, const ArrayArg& b_arg, const OptionalArrayArg& field_a,

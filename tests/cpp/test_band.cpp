@@ -1,4 +1,4 @@
-// The analogy's band helpers against brute-force references.
+// The analogy's band helpers and padding against brute-force references.
 #include <gtest/gtest.h>
 #include <tbb/global_control.h>
 
@@ -8,6 +8,8 @@
 #include <vector>
 
 #include "analogy/band.hpp"
+#include "analogy/features.hpp"
+#include "exsynth/analogy.hpp"
 #include "exsynth/errors.hpp"
 
 using namespace exsynth;
@@ -65,4 +67,18 @@ TEST(SortedBy, ACancelStopsIt) {
   EXPECT_NO_THROW(analogy::sorted_by(key, progress));
   ctx.cancel();
   EXPECT_THROW(analogy::sorted_by(key, progress), Cancelled);
+}
+
+TEST(AnalogyPadding, CoversEveryNeighbourhoodOffsetAtTheFinestLevel) {
+  // Brute force over the neighbourhoods the analogy samples: the farthest
+  // fine offset, plus the farthest coarse one in fine voxels (x2).
+  for (int fine = 3; fine <= 9; fine += 2)
+    for (int coarse = 1; coarse <= 7; coarse += 2) {
+      const analogy::Neighbourhoods n = analogy::make_neighbourhoods(fine, coarse, false);
+      float reach = 0, coarse_reach = 0;
+      for (const auto& o : n.fine) reach = std::max(reach, o.cwiseAbs().maxCoeff());
+      for (const auto& o : n.coarse) coarse_reach = std::max(coarse_reach, o.cwiseAbs().maxCoeff());
+      EXPECT_EQ(analogy_padding(fine, coarse), int(reach + 2 * coarse_reach)) << fine << ", " << coarse;
+    }
+  EXPECT_EQ(analogy_padding(), analogy_padding(AnalogyOptions{}.fine_size, AnalogyOptions{}.coarse_size));
 }

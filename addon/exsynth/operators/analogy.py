@@ -34,7 +34,6 @@ PRESETS = ("spikes", "pits", "holes", "grooves", "dilate")
 FIELD_PRESETS = tuple(field_ops.PRESETS.values())  # around_axis, along_axis, along_curve
 PAIR_MIN, PAIR_MAX = 8, 512  # make_exemplar_pair's resolution range
 MAX_GRID_SIDE = 2048  # voxels along one side of a user pair's grid
-NEIGHBOURHOOD_PADDING = 4  # fine 5^3 (2 voxels) + coarse 3^3 at half resolution (2 voxels)
 
 # How far A' reaches beyond A in the pair's own units (the pair spans
 # [-1, 1]^3): the grid around B needs that much room to grow into.
@@ -176,14 +175,14 @@ class GeometricTextureJob(Job):
         into, plus the neighbourhoods."""
         key = _PAIR_GROWTH.get(self.preset)
         growth = self.pair_options.get(key, _DEFAULT_GROWTH.get(key, 0.0)) if key else 0.0
-        return int(math.ceil(growth * self.pair_resolution / 2.0)) + NEIGHBOURHOOD_PADDING
+        return int(math.ceil(growth * self.pair_resolution / 2.0)) + _native.analogy_padding()
 
     def run(self, ctx):
         h = voxel_size_for(self.b.vertices, self.resolution)
         common = dict(supersample=2, compute_sdf=True, memory_budget=self.memory_budget, seed=self.seed, ctx=ctx)
         if self.user_pair:
             a, a_prime, field_a, growth, region = self._user_pair(h, common, ctx)
-            padding = int(math.ceil(growth / h)) + NEIGHBOURHOOD_PADDING
+            padding = int(math.ceil(growth / h)) + _native.analogy_padding()
             scale, h_a = 1.0, h
         else:
             padding = self.padding()
@@ -246,7 +245,7 @@ class GeometricTextureJob(Job):
             self.share(ctx, 0.04 * k, 0.04 * (k + 1))
             verts = np.concatenate([np.asarray(mesh.vertices, np.float64), corners])
             grids.append(_voxelize("A′" if k else "A", verts, mesh.triangles, voxel_size=h,
-                                   padding=NEIGHBOURHOOD_PADDING + 1, **common))
+                                   padding=_native.analogy_padding() + 1, **common))
         a, a_prime = grids[0]["sdf"], grids[1]["sdf"]
         if float(np.abs(a - a_prime).max()) < 0.1 * h:
             raise ValueError(
@@ -265,10 +264,10 @@ class GeometricTextureJob(Job):
             verts, tris = self.a.region
             self.share(ctx, 0.12, 0.15)
             near = _voxelize("the selected faces of A", np.concatenate([np.asarray(verts, np.float64), corners]),
-                             tris, voxel_size=h, padding=NEIGHBOURHOOD_PADDING + 1, **common)["sdf"]
+                             tris, voxel_size=h, padding=_native.analogy_padding() + 1, **common)["sdf"]
             if near.shape != a.shape:
                 raise RuntimeError(f"the selected faces' grid {near.shape} is not A's {a.shape}")
-            region = (np.abs(near) <= growth + NEIGHBOURHOOD_PADDING * h).astype(np.float32)
+            region = (np.abs(near) <= growth + _native.analogy_padding() * h).astype(np.float32)
         return a, a_prime, field_a, growth, region
 
 
@@ -316,7 +315,7 @@ def check_user_pair_grid(b_vertices, a_vertices, a_prime_vertices, resolution):
         )
     h = voxel_size_for(b_vertices, resolution)
     both = np.concatenate([a_vertices, a_prime_vertices])
-    sides = np.ceil((both.max(0) - both.min(0)) / h).astype(np.int64) + 2 * (NEIGHBOURHOOD_PADDING + 1)
+    sides = np.ceil((both.max(0) - both.min(0)) / h).astype(np.int64) + 2 * (_native.analogy_padding() + 1)
     if sides.max() > MAX_GRID_SIDE:
         raise InputError(
             f"A and A′ are {sides.max()} voxels across at B's voxel size (Resolution {resolution}); "

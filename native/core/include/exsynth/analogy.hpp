@@ -87,6 +87,12 @@ struct AnalogyResult {
   std::size_t debris = 0;      ///< voxels changed by remove_debris
 };
 
+/// Empty voxels a grid needs around a surface so that every neighbourhood
+/// of the finest level stays inside it: the fine cube's half-width plus the
+/// coarse cube's, whose voxels are twice as large (4 with the defaults).
+/// Voxelize A, A' and B with at least this padding (plus the pattern's growth).
+int analogy_padding(int fine_size = AnalogyOptions{}.fine_size, int coarse_size = AnalogyOptions{}.coarse_size);
+
 /// Isotropic analogy (global frame, scanline order).
 /// a, a_prime: same grid, 1 channel; b: 1 channel, any size; A and B must
 /// share a voxel size (the pattern is copied voxel for voxel).

@@ -108,6 +108,8 @@ AnalogyResult run(const Volume& a, const Volume& a_prime, const Volume* field_a,
 
 }  // namespace
 
+int analogy_padding(int fine_size, int coarse_size) { return fine_size / 2 + 2 * (coarse_size / 2); }
+
 AnalogyResult synthesize_analogy(const Volume& a, const Volume& a_prime, const Volume& b, const AnalogyOptions& opt,
                                  ExecContext* ctx) {
   return run(a, a_prime, nullptr, b, nullptr, opt, ctx);
