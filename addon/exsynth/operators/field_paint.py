@@ -305,20 +305,34 @@ class EXSYNTH_OT_paint_direction_field(bpy.types.Operator):
     bl_label = "Paint Direction Field"
     bl_options = {'UNDO'}
 
-    def invoke(self, context, event):
-        settings = context.scene.exsynth
+    def _start(self, context):
+        """The session for the active mesh, or None after reporting what to change."""
         if context.mode != 'OBJECT':
             self.report({'ERROR'}, "Paint Direction Field: works in Object Mode only. Press Tab to leave Edit "
                         "Mode and start it again")
-            return {'CANCELLED'}
+            return None
         try:
-            self.session = PaintSession(context.active_object, settings.field_paint_attribute)
+            session = PaintSession(context.active_object, context.scene.exsynth.field_paint_attribute)
         except InputError as exc:
             self.report({'ERROR'}, f"Paint Direction Field: {exc}")
-            return {'CANCELLED'}
+            return None
         if context.area is None or context.area.type != 'VIEW_3D':
-            self.report({'ERROR'}, "Paint Direction Field: start it from a 3D viewport (the ExSynth tab of its "
-                        "sidebar)")
+            self.report({'ERROR'}, "Paint Direction Field is interactive: start it from a 3D viewport (the "
+                        "ExSynth tab of its sidebar, or F3 over the viewport)")
+            return None
+        return session
+
+    def execute(self, context):
+        # Scripts and `blender -b` have no mouse to paint with: the same checks, then the same advice.
+        if self._start(context) is not None:
+            self.report({'ERROR'}, "Paint Direction Field is interactive: invoke it (INVOKE_DEFAULT) in a 3D "
+                        "viewport, or use PaintSession from a script")
+        return {'CANCELLED'}
+
+    def invoke(self, context, event):
+        settings = context.scene.exsynth
+        self.session = self._start(context)
+        if self.session is None:
             return {'CANCELLED'}
         from mathutils.bvhtree import BVHTree
 
