@@ -5,9 +5,8 @@ the places where the field is singular.
 
 Singular means one of:
 - undefined: a vertex whose vector is zero, not finite or not unit-ish;
-- a vortex, source or saddle: a triangle around which the field turns by a
-  whole turn (its discrete index, the sum of the angle steps between its
-  corners' vectors in the triangle's plane, is a non-zero multiple of 2 pi);
+- a vortex, source, sink or saddle: a vertex around whose one-ring the field
+  turns by a whole turn (its discrete index, see vertex_indices);
 - a clash: an edge whose two vectors point more than 90 degrees apart (where
   painted strokes meet head-on, or across a seam).
 """
@@ -56,24 +55,36 @@ def undefined_vertices(field):
     return np.nonzero(~finite | (length < 0.5))[0]
 
 
-def triangle_indices(vertices, triangles, field):
-    """The field's discrete index (turns, an integer) around each triangle."""
-    v = np.asarray(vertices, np.float64)
+def vertex_indices(triangles, field, normals):
+    """The field's winding (turns, an integer) around each vertex's one-ring.
+
+    For each triangle (a, b, c) the step from b's vector to c's is measured in
+    a's tangent plane and added to a; summed over a's fan this is how often the
+    field turns going once around a. Measuring every step of a ring in one
+    plane (the vertex's) makes the sum an exact multiple of a turn whatever
+    the vertex's own vector is, so a singularity sitting on a vertex (a
+    preset's pole on a symmetric mesh) is found as surely as one inside a
+    triangle (whose three corners all see it). Open rings (boundary vertices)
+    do not close: they count only when the sum is within a quarter turn of
+    a whole one.
+    """
     t = np.asarray(triangles, np.int64)
     f = np.nan_to_num(np.asarray(field, np.float64))
-    p0, p1, p2 = v[t[:, 0]], v[t[:, 1]], v[t[:, 2]]
-    n = normalized(np.cross(p1 - p0, p2 - p0))
-    e1 = normalized(p1 - p0)
+    n = np.asarray(normals, np.float64)
+    # A tangent basis per vertex: e1 from the coordinate axis least along the normal.
+    helper = np.eye(3)[np.argmin(np.abs(n), axis=1)]
+    e1 = normalized(np.cross(n, helper))
     e2 = np.cross(n, e1)
-    angles = []
+    total = np.zeros(len(n))
     for k in range(3):
-        fk = f[t[:, k]]
-        angles.append(np.arctan2(np.sum(fk * e2, axis=1), np.sum(fk * e1, axis=1)))
-    total = np.zeros(len(t))
-    for k in range(3):
-        step = angles[(k + 1) % 3] - angles[k]
-        total += (step + np.pi) % (2.0 * np.pi) - np.pi  # wrapped into [-pi, pi)
-    return np.rint(total / (2.0 * np.pi)).astype(np.int64)
+        a, b, c = t[:, k], t[:, (k + 1) % 3], t[:, (k + 2) % 3]
+        angle_b = np.arctan2(np.sum(f[b] * e2[a], axis=1), np.sum(f[b] * e1[a], axis=1))
+        angle_c = np.arctan2(np.sum(f[c] * e2[a], axis=1), np.sum(f[c] * e1[a], axis=1))
+        np.add.at(total, a, (angle_c - angle_b + np.pi) % (2.0 * np.pi) - np.pi)
+    turns = total / (2.0 * np.pi)
+    index = np.rint(turns).astype(np.int64)
+    index[np.abs(turns - index) > 0.25] = 0
+    return index
 
 
 def mesh_edges(triangles):
@@ -105,8 +116,8 @@ def singular_points(vertices, triangles, field, normals, lift, edges=None):
     pts = [v[bad_v] + lift * nrm[bad_v]]
     t = np.asarray(triangles, np.int64)
     if len(t):
-        singular = t[triangle_indices(v, t, field) != 0]
-        pts.append(v[singular].mean(axis=1) + lift * nrm[singular].mean(axis=1))
+        singular = np.nonzero(vertex_indices(t, field, nrm) != 0)[0]
+        pts.append(v[singular] + lift * nrm[singular])
         clash = clash_edges(mesh_edges(t) if edges is None else edges, field)
         clash_pts = v[clash].mean(axis=1) + lift * nrm[clash].mean(axis=1)
     else:

@@ -206,22 +206,38 @@ def test_strokes_run_from_the_lifted_vertex_along_the_field():
     np.testing.assert_allclose(tails[:, 2], 0.01, atol=1e-7)
 
 
-def test_triangle_indices_find_a_vortex_a_saddle_and_nothing_in_a_uniform_field():
+def test_vertex_indices_find_a_vortex_a_saddle_and_nothing_in_a_uniform_field():
     verts, tris = grid(20)
-    # Centred off the grid's vertices and edges (on an edge the turn splits half and half).
-    x, y = verts[:, 0] - 0.031, verts[:, 1] - 0.017
+    normals = field_brush.vertex_normals(verts, tris)
+    centre = np.array([0.031, 0.017, 0.0])  # off the grid's vertices and edges
+    x, y = verts[:, 0] - centre[0], verts[:, 1] - centre[1]
     cases = {"uniform": (np.ones_like(x), np.zeros_like(x), 0),
              "vortex": (-y, x, 1), "source": (x, y, 1), "saddle": (x, -y, -1)}
     for name, (fx, fy, index) in cases.items():
         field = np.stack([fx, fy, np.zeros_like(x)], 1)
-        ind = field_glyphs.triangle_indices(verts, tris, field)
+        ind = field_glyphs.vertex_indices(tris, field, normals)
         nonzero = np.nonzero(ind)[0]
         if index == 0:
             assert len(nonzero) == 0, name
         else:
-            assert 1 <= len(nonzero) <= 2 and np.all(ind[nonzero] == index), name
-            centre = verts[tris[nonzero]].mean(axis=1)
-            assert np.all(np.linalg.norm(centre - [0.031, 0.017, 0], axis=1) < 0.15), name
+            # The corners of the triangle holding the centre see it, nobody else.
+            assert 3 <= len(nonzero) <= 4 and np.all(ind[nonzero] == index), name
+            assert np.all(np.linalg.norm(verts[nonzero] - centre, axis=1) < 0.2), name
+
+
+def test_vertex_indices_find_a_singularity_on_a_vertex_whatever_its_vector():
+    # A sink centred exactly on a vertex, whose own vector is opposite one of
+    # its neighbours' (the case a per-triangle index misses: a half-turn step).
+    verts, tris = grid(21)
+    normals = field_brush.vertex_normals(verts, tris)
+    field = -np.stack([verts[:, 0], verts[:, 1], np.zeros(len(verts))], 1)
+    middle = int(np.argmin(np.linalg.norm(verts, axis=1)))
+    for own in ([0.0, 1.0, 0.0], [0.0, -1.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, 0.0]):
+        field[middle] = own
+        ind = field_glyphs.vertex_indices(tris, field, normals)
+        # Found at the vertex; a neighbour its own vector points away from may be marked too.
+        found = np.nonzero(ind)[0]
+        assert ind[middle] == 1 and np.all(np.linalg.norm(verts[found] - verts[middle], axis=1) < 0.11), own
 
 
 def test_singular_points_mark_undefined_vertices_and_clashes():
