@@ -107,9 +107,11 @@ def apply_brush(constraints, field, positions, normals, centre, radius, directio
     world, so that distances are true); direction (3,), normals and the
     constraints and field vectors: the mesh's own space. `field` may be None
     (no field yet). Modes:
-      PAINT: blends each vertex's current direction (its constraint, else its
-        field) towards the stroke's by the falloff weight: the stroke's own
-        direction at the centre, a smooth join at the rim.
+      PAINT: a free vertex takes the stroke's direction; a painted one turns
+        towards it by the falloff weight (fully at the centre, barely at the
+        rim), so crossing strokes join smoothly. The diffused field is not
+        used: copying it into constraints at the rim would pin the old field
+        right next to the stroke and stop the stroke from spreading.
       ERASE: frees every vertex within the radius (a constraint is there or
         not, so no falloff).
       COMB: adds COMB_RATE x weight x the stroke direction to the current
@@ -132,10 +134,10 @@ def apply_brush(constraints, field, positions, normals, centre, radius, directio
     ok = np.any(t != 0.0, axis=1)
     idx, t, w = idx[ok], t[ok], strength * weight[idx[ok]]
     current = normalized(constraints[idx])
-    if field is not None:
+    if field is not None and mode == "COMB":
         free = ~np.any(current != 0.0, axis=1)
         current[free] = normalized(np.asarray(field, np.float64)[idx[free]])
-    unknown = ~np.any(current != 0.0, axis=1)  # no constraint, no field: take the stroke's
+    unknown = ~np.any(current != 0.0, axis=1)  # nothing to turn: take the stroke's
     current[unknown] = t[unknown]
     if mode == "PAINT":
         new = (1.0 - w)[:, None] * current + w[:, None] * t

@@ -16,12 +16,28 @@ import numpy as np
 from .field_brush import normalized
 
 
-def stroke_indices(n_vertices, max_strokes):
-    """Every k-th vertex, k chosen so that at most `max_strokes` are drawn."""
+def stroke_indices(vertices, triangles, max_strokes):
+    """About `max_strokes` vertices spread evenly over the surface, and their
+    spacing: one vertex per cell of a grid whose cell area is the surface's
+    area over `max_strokes` (every n-th vertex instead would crowd strokes
+    where the mesh is dense, e.g. at a UV sphere's poles). At most
+    `max_strokes`: extra cells are thinned by taking every k-th."""
     if max_strokes < 1:
         raise ValueError(f"max_strokes must be at least 1, got {max_strokes}")
-    stride = max(1, -(-n_vertices // max_strokes))
-    return np.arange(0, n_vertices, stride), stride
+    v = np.asarray(vertices, np.float64)
+    t = np.asarray(triangles, np.int64)
+    if len(v) == 0:
+        return np.zeros(0, np.int64), 0.0
+    area = 0.5 * np.linalg.norm(np.cross(v[t[:, 1]] - v[t[:, 0]], v[t[:, 2]] - v[t[:, 0]]), axis=1).sum()
+    if area <= 0:
+        return np.arange(0, len(v), max(1, -(-len(v) // max_strokes))), 0.0
+    spacing = float(np.sqrt(area / max_strokes))
+    cells = np.floor((v - v.min(axis=0)) / spacing).astype(np.int64)
+    _, first = np.unique(cells, axis=0, return_index=True)
+    idx = np.sort(first)
+    if len(idx) > max_strokes:
+        idx = idx[:: -(-len(idx) // max_strokes)]
+    return idx, spacing
 
 
 def mean_edge_length(vertices, triangles):

@@ -104,7 +104,8 @@ def geometry(obj, settings):
            settings.field_overlay_singularities)
     if key == _cache["key"]:
         return _cache["geometry"]
-    topology_key = (mesh.as_pointer(), len(co), hash(tris.tobytes()), hash(co.tobytes()))
+    topology_key = (mesh.as_pointer(), len(co), hash(tris.tobytes()), hash(co.tobytes()),
+                    settings.field_overlay_max_strokes)
     if topology_key != _cache["topology_key"]:
         from .field_brush import vertex_normals
 
@@ -112,11 +113,11 @@ def geometry(obj, settings):
             "normals": vertex_normals(co, tris),
             "edge": field_glyphs.mean_edge_length(co, tris),
             "edges": field_glyphs.mesh_edges(tris),
+            "strokes": field_glyphs.stroke_indices(co, tris, settings.field_overlay_max_strokes),
         }
         _cache["topology_key"] = topology_key
     topo = _cache["topology"]
-    idx, stride = field_glyphs.stroke_indices(len(co), settings.field_overlay_max_strokes)
-    spacing = topo["edge"] * np.sqrt(stride)
+    idx, spacing = topo["strokes"]
     lift = 0.05 * topo["edge"]
     out = {"segments": field_glyphs.strokes(co, topo["normals"], field, idx,
                                             settings.field_overlay_length * spacing, lift)}

@@ -317,6 +317,7 @@ def paint_start():
     others = [c for c in panels.CLASSES if c.__name__ != "EXSYNTH_PT_field"]
     for cls in sorted(others, key=lambda c: not getattr(c, "bl_parent_id", "")):  # sub-panels first
         bpy.utils.unregister_class(cls)
+    _record_draws(bpy.types.EXSYNTH_PT_field)
     overlay.stats.update(draws=0, vertices=0)
     settings.field_overlay = True
     settings.field_overlay_max_strokes = 1500
@@ -367,7 +368,36 @@ def paint_diffused():
             check(False, f"the stroke turns the field its way while the tool runs (mean dot {dot:.2f})")
         return 0.2
     check(True, f"the stroke turns the field its way while the tool runs (mean dot {dot:.2f})")
+    drawn.discard("EXSYNTH_PT_field")
     _viewport()[1].tag_redraw()
+    state.update(step="paint_tab", tabs=0)
+    return 0.3
+
+
+def paint_tab():
+    """The sidebar on the ExSynth tab (stepping through tabs with Ctrl+Wheel
+    when this part runs alone), then a three-quarter view for the picture."""
+    from mathutils import Euler
+
+    win, area, region = _viewport()
+    if "EXSYNTH_PT_field" not in drawn:
+        if state["tabs"] >= 8:
+            check(False, "the Direction Field panel draws while painting")
+        ui = next(r for r in area.regions if r.type == 'UI')
+        x, y = ui.x + ui.width - 8, ui.y + ui.height - 60
+        win.event_simulate('MOUSEMOVE', 'NOTHING', x=x, y=y)
+        win.event_simulate('WHEELDOWNMOUSE', 'PRESS', x=x, y=y, ctrl=True)
+        area.tag_redraw()
+        state["tabs"] += 1
+        return 0.3
+    check(True, "the Direction Field panel draws while painting")
+    rv3d = area.spaces.active.region_3d
+    rv3d.view_perspective = 'PERSP'
+    rv3d.view_rotation = Euler((0.9, 0.0, 0.5)).to_quaternion()
+    rv3d.view_distance = 4.5
+    settings = bpy.context.scene.exsynth
+    settings.field_overlay_max_strokes, settings.field_overlay_length = 500, 1.0  # fewer, longer: readable
+    area.tag_redraw()
     state.update(step="paint_screenshot")
     return 0.5
 
@@ -406,6 +436,7 @@ STEPS = {"start": start, "wait_finish": wait_finish, "press_esc": press_esc, "af
          "geo_start": geo_start, "geo_finish": geo_finish, "geo_undone": geo_undone,
          "geo_pair_drawn": geo_pair_drawn, "pts_start": pts_start, "pts_finish": pts_finish,
          "pts_undone": pts_undone, "paint_start": paint_start, "paint_overlay": paint_overlay,
-         "paint_release": paint_release, "paint_diffused": paint_diffused, "paint_screenshot": paint_screenshot,
+         "paint_release": paint_release, "paint_diffused": paint_diffused, "paint_tab": paint_tab,
+         "paint_screenshot": paint_screenshot,
          "paint_ended": paint_ended, "paint_undone": paint_undone}
 bpy.app.timers.register(step, first_interval=1.0)

@@ -106,18 +106,27 @@ def test_paint_sets_the_stroke_direction_inside_the_radius_only():
     assert not np.any(c[~inside])
 
 
-def test_paint_blends_with_the_field_by_the_falloff():
+def test_paint_turns_painted_directions_by_the_falloff_and_ignores_the_field():
     verts, _, normals, c = brush_setup()
-    field = np.tile(np.array([1.0, 0.0, 0.0], np.float32), (len(verts), 1))
+    c[:] = (1.0, 0.0, 0.0)  # an earlier stroke along x everywhere
+    field = np.tile(np.array([0.0, 0.0, 0.0], np.float32), (len(verts), 1))
     field_brush.apply_brush(c, field, verts, normals, [0, 0, 0], 0.5, [0.0, 1.0, 0.0])
     dist = np.linalg.norm(verts, axis=1)
     inside = np.nonzero(dist < 0.5)[0]
-    # The angle from the field's x towards the stroke's y grows with the weight.
+    # The angle from x towards the stroke's y grows with the weight.
     angle = np.arctan2(c[inside, 1], c[inside, 0])
     w = field_brush.falloff(dist[inside], 0.5)
     expect = np.arctan2(w, 1 - w)  # normalize((1 - w) x + w y)
     np.testing.assert_allclose(angle, expect, atol=1e-6)
     assert np.allclose(c[np.argmin(dist)], [0, 1, 0])  # the centre takes the stroke's direction
+
+
+def test_paint_on_free_vertices_does_not_copy_the_old_field():
+    verts, _, normals, c = brush_setup()
+    field = np.tile(np.array([1.0, 0.0, 0.0], np.float32), (len(verts), 1))
+    field_brush.apply_brush(c, field, verts, normals, [0, 0, 0], 0.5, [0.0, 1.0, 0.0])
+    painted = np.any(c != 0, axis=1)
+    np.testing.assert_allclose(c[painted], np.tile([0, 1, 0], (painted.sum(), 1)), atol=1e-6)
 
 
 def test_erase_frees_every_painted_vertex_within_the_radius():
@@ -152,12 +161,14 @@ def test_comb_without_a_field_or_paint_acts_as_paint():
     np.testing.assert_allclose(c[painted], np.tile([0, 1, 0], (painted.sum(), 1)), atol=1e-6)
 
 
-def test_paint_opposite_to_the_field_half_way_takes_the_stroke():
+def test_paint_opposite_to_a_painted_direction_half_way_takes_the_stroke():
     verts, _, normals, c = brush_setup()
-    field = np.tile(np.array([1.0, 0.0, 0.0], np.float32), (len(verts), 1))
+    c[:] = (1.0, 0.0, 0.0)
     # At weight exactly 0.5 the blend of x and -x cancels: the stroke's direction wins.
     r = 0.5 / np.sqrt(1 - np.sqrt(0.5))  # falloff(0.5, r) == 0.5
-    field_brush.apply_brush(c, field, verts[:1] * 0 + [[0.5, 0, 0]], normals[:1], [0, 0, 0], r, [-1.0, 0, 0])
+    one = c[:1]
+    field_brush.apply_brush(one, None, verts[:1] * 0 + [[0.5, 0, 0]], normals[:1], [0, 0, 0], r, [-1.0, 0, 0])
+    c = one
     assert np.all(np.isfinite(c)) and np.linalg.norm(c[0]) == pytest.approx(1.0)
 
 
@@ -185,13 +196,22 @@ def test_a_painted_stroke_diffuses_into_a_field_along_it():
 
 
 # ---- overlay geometry ------------------------------------------------------------
-def test_stroke_indices_respect_the_maximum():
-    idx, stride = field_glyphs.stroke_indices(1000, 300)
-    assert stride == 4 and len(idx) <= 300 and idx[0] == 0
-    idx, stride = field_glyphs.stroke_indices(10, 300)
-    assert stride == 1 and len(idx) == 10
+def test_stroke_indices_spread_evenly_and_respect_the_maximum():
+    verts, tris = grid(41)  # 4 square units, 1681 vertices
+    idx, spacing = field_glyphs.stroke_indices(verts, tris, 100)
+    assert spacing == pytest.approx(0.2) and 50 <= len(idx) <= 100 and len(set(idx)) == len(idx)
+    # Evenly: every chosen vertex's nearest chosen neighbour is about one spacing away.
+    p = verts[idx]
+    d = np.linalg.norm(p[:, None] - p[None], axis=2) + np.eye(len(p)) * 9
+    assert np.all(d.min(axis=1) > 0.5 * spacing) and np.all(d.min(axis=1) < 2.5 * spacing)
+    # Denser vertices in one corner do not get more strokes there.
+    extra = np.random.default_rng(0).uniform(-1.0, -0.5, (4000, 2))
+    dense = np.concatenate([verts, np.c_[extra, np.zeros(4000)]])
+    idx2, _ = field_glyphs.stroke_indices(dense, tris, 100)
+    assert abs(len(idx2) - len(idx)) <= 5
+    assert len(field_glyphs.stroke_indices(verts, tris, 10000)[0]) <= 10000
     with pytest.raises(ValueError):
-        field_glyphs.stroke_indices(10, 0)
+        field_glyphs.stroke_indices(verts, tris, 0)
 
 
 def test_strokes_run_from_the_lifted_vertex_along_the_field():

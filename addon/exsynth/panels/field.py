@@ -48,11 +48,13 @@ class EXSYNTH_PT_field(bpy.types.Panel):
         col.prop(settings, "field_brush_mode")
         col.prop(settings, "field_brush_radius")
         col.prop(settings, "field_brush_strength")
-        col.row().prop(settings, "field_mirror", toggle=True)
+        row = col.row(heading="Mirror", align=True)
+        for k, axis in enumerate("XYZ"):
+            row.prop(settings, "field_mirror", index=k, text=axis, toggle=True)
         row = box.row()
         row.scale_y = 1.3
         row.operator("exsynth.paint_direction_field", icon='BRUSH_DATA')
-        box.label(text="Drag on the mesh · Esc/right-click: done", icon='INFO')
+        box.label(text="Drag on the mesh", icon='INFO')
 
         # The overlay: drawn from 'exsynth_field' whatever made it.
         box = layout.box()
