@@ -11,7 +11,7 @@ import time
 
 import numpy as np
 
-from exsynth import _native, field_brush
+from exsynth import _native, field_brush, field_glyphs
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 
@@ -84,6 +84,20 @@ def main():
     _, wall, cpu = timed(lambda: _native.diffuse_direction_field(verts, tris, c))
     print(f"diffusion of that stroke: {1000 * wall:.0f} ms wall, {1000 * cpu:.0f} ms CPU "
           f"(user+sys of this process, 2 threads); load average {os.getloadavg()[0]:.1f}")
+    field = _native.diffuse_direction_field(verts, tris, c)
+    edges = field_glyphs.mesh_edges(tris)
+
+    def overlay():
+        idx, spacing = field_glyphs.stroke_indices(verts, tris, 4000)
+        seg = field_glyphs.strokes(verts, normals, field, idx, 0.8 * spacing, 0.0)
+        return seg, field_glyphs.singular_points(verts, tris, field, normals, 0.0, edges=edges)
+
+    (seg, (sing, clash)), wall, cpu = timed(overlay)
+    print(f"overlay geometry (4000 strokes, singularities): {1000 * wall:.0f} ms wall, {1000 * cpu:.0f} ms CPU; "
+          f"{len(seg) // 2} strokes, {len(sing)} singular, {len(clash)} clash points")
+    f32 = field.astype(np.float32)
+    _, wall, cpu = timed(lambda: hash(f32.tobytes()), repeat=10)
+    print(f"per-draw change check (hash of the field): {1000 * wall:.1f} ms wall")
     return 0
 
 

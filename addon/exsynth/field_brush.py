@@ -35,9 +35,9 @@ def vertex_normals(vertices, triangles):
     v = np.asarray(vertices, np.float64)
     t = np.asarray(triangles, np.int64)
     face = np.cross(v[t[:, 1]] - v[t[:, 0]], v[t[:, 2]] - v[t[:, 0]])
-    n = np.zeros_like(v)
-    for k in range(3):
-        np.add.at(n, t[:, k], face)
+    corners = t.ravel()  # each face's cross product goes to its three corners
+    faces3 = np.repeat(face, 3, axis=0)
+    n = np.stack([np.bincount(corners, faces3[:, k], minlength=len(v)) for k in range(3)], axis=1)
     return normalized(n)
 
 

@@ -33,7 +33,9 @@ def stroke_indices(vertices, triangles, max_strokes):
         return np.arange(0, len(v), max(1, -(-len(v) // max_strokes))), 0.0
     spacing = float(np.sqrt(area / max_strokes))
     cells = np.floor((v - v.min(axis=0)) / spacing).astype(np.int64)
-    _, first = np.unique(cells, axis=0, return_index=True)
+    dims = cells.max(axis=0) + 1
+    key = (cells[:, 0] * dims[1] + cells[:, 1]) * dims[2] + cells[:, 2]  # one int64 per cell: fast unique
+    _, first = np.unique(key, return_index=True)
     idx = np.sort(first)
     if len(idx) > max_strokes:
         idx = idx[:: -(-len(idx) // max_strokes)]
@@ -87,16 +89,15 @@ def vertex_indices(triangles, field, normals):
     t = np.asarray(triangles, np.int64)
     f = np.nan_to_num(np.asarray(field, np.float64))
     n = np.asarray(normals, np.float64)
-    # A tangent basis per vertex: e1 from the coordinate axis least along the normal.
-    helper = np.eye(3)[np.argmin(np.abs(n), axis=1)]
-    e1 = normalized(np.cross(n, helper))
-    e2 = np.cross(n, e1)
     total = np.zeros(len(n))
     for k in range(3):
         a, b, c = t[:, k], t[:, (k + 1) % 3], t[:, (k + 2) % 3]
-        angle_b = np.arctan2(np.sum(f[b] * e2[a], axis=1), np.sum(f[b] * e1[a], axis=1))
-        angle_c = np.arctan2(np.sum(f[c] * e2[a], axis=1), np.sum(f[c] * e1[a], axis=1))
-        np.add.at(total, a, (angle_c - angle_b + np.pi) % (2.0 * np.pi) - np.pi)
+        fb, fc, na = f[b], f[c], n[a]
+        # The signed angle from b's vector to c's, both projected into a's
+        # tangent plane: atan2(n . (fb x fc), pb . pc), in (-pi, pi].
+        nb, nc = np.einsum("ij,ij->i", fb, na), np.einsum("ij,ij->i", fc, na)
+        step = np.arctan2(np.einsum("ij,ij->i", np.cross(fb, fc), na), np.einsum("ij,ij->i", fb, fc) - nb * nc)
+        total += np.bincount(a, step, minlength=len(n))
     turns = total / (2.0 * np.pi)
     index = np.rint(turns).astype(np.int64)
     index[np.abs(turns - index) > 0.25] = 0

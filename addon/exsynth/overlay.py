@@ -24,6 +24,11 @@ SINGULAR_COLOUR = (1.0, 0.1, 0.1, 1.0)
 CLASH_COLOUR = (1.0, 0.5, 0.0, 1.0)
 
 _handle = None
+# Set by the paint tool while a stroke is dragged: on meshes above
+# LIVE_SINGULARITY_LIMIT vertices the singularity pass (~0.5 s at 100 k under
+# load) would stall the brush at every diffusion, so it waits for the release.
+stroking = False
+LIVE_SINGULARITY_LIMIT = 50000
 # What the last draw did (the GUI smoke test reads it): draws counted, stroke
 # vertices and singular points in the last one.
 stats = {"draws": 0, "vertices": 0, "singular": 0, "clashes": 0, "object": None}
@@ -101,7 +106,7 @@ def geometry(obj, settings):
     co, field, tris = _mesh_arrays(mesh)
     key = (mesh.as_pointer(), len(co), len(tris), hash(co.tobytes()), hash(field.tobytes()),
            settings.field_overlay_max_strokes, round(settings.field_overlay_length, 6),
-           settings.field_overlay_singularities)
+           settings.field_overlay_singularities, stroking and len(co) > LIVE_SINGULARITY_LIMIT)
     if key == _cache["key"]:
         return _cache["geometry"]
     topology_key = (mesh.as_pointer(), len(co), hash(tris.tobytes()), hash(co.tobytes()),
@@ -121,7 +126,8 @@ def geometry(obj, settings):
     lift = 0.05 * topo["edge"]
     out = {"segments": field_glyphs.strokes(co, topo["normals"], field, idx,
                                             settings.field_overlay_length * spacing, lift)}
-    if settings.field_overlay_singularities and len(tris):
+    deferred = stroking and len(co) > LIVE_SINGULARITY_LIMIT
+    if settings.field_overlay_singularities and len(tris) and not deferred:
         out["singular"], out["clashes"] = field_glyphs.singular_points(
             co, tris, field, topo["normals"], lift, edges=topo["edges"])
     else:

@@ -239,3 +239,11 @@ def test_overlay_geometry_follows_the_field_and_survives_odd_objects(sphere):
     bpy.data.objects.remove(sphere)
     bpy.context.view_layer.objects.active = None
     assert overlay.field_object(ctx) is None
+
+
+def test_compat_names_the_gpu_shaders_for_this_blender():
+    from exsynth import compat
+
+    expect = "UNIFORM_COLOR" if bpy.app.version >= (4, 0, 0) else "3D_UNIFORM_COLOR"
+    assert compat.builtin_shader_name("UNIFORM_COLOR") == expect
+    assert compat.builtin_shader_name("POLYLINE_SMOOTH_COLOR").endswith("POLYLINE_SMOOTH_COLOR")

@@ -22,7 +22,7 @@ import threading
 import bpy
 import numpy as np
 
-from .. import _native, field_brush
+from .. import _native, field_brush, overlay
 from ..io import mesh as mesh_io
 from ..jobs import REPORTED_ERRORS, InputError
 from .field import FIELD_ATTRIBUTE, check_field_slot, read_vectors
@@ -367,11 +367,11 @@ class EXSYNTH_OT_paint_direction_field(bpy.types.Operator):
                 self._sample(context, event)
                 return {'RUNNING_MODAL'}
             if kind == 'LEFTMOUSE' and value == 'RELEASE':
-                self.stroking = False
+                self.stroking = overlay.stroking = False
                 self.session.end_stroke()
                 return {'RUNNING_MODAL'}
             if kind in {'ESC', 'RIGHTMOUSE'} and value == 'PRESS':
-                self.stroking = False
+                self.stroking = overlay.stroking = False
                 self.session.cancel_stroke()
                 self._header(context, "stroke cancelled")
                 return {'RUNNING_MODAL'}
@@ -380,6 +380,7 @@ class EXSYNTH_OT_paint_direction_field(bpy.types.Operator):
             if _view_region(context, event) is None:
                 return {'PASS_THROUGH'}  # the sidebar, header...: their buttons work
             self.stroking, self.last = True, None
+            overlay.stroking = True
             self.session.begin_stroke()
             self._sample(context, event)
             return {'RUNNING_MODAL'}
@@ -450,6 +451,7 @@ class EXSYNTH_OT_paint_direction_field(bpy.types.Operator):
     # ---- ending ----------------------------------------------------------------
     def _end(self, context, keep):
         settings = context.scene.exsynth
+        overlay.stroking = False
         context.window_manager.event_timer_remove(self.timer)
         if context.area is not None:
             context.area.header_text_set(None)
