@@ -84,6 +84,13 @@ def main():
     _, wall, cpu = timed(lambda: _native.diffuse_direction_field(verts, tris, c))
     print(f"diffusion of that stroke: {1000 * wall:.0f} ms wall, {1000 * cpu:.0f} ms CPU "
           f"(user+sys of this process, 2 threads); load average {os.getloadavg()[0]:.1f}")
+    # The same stroke's share of the mesh on the original 26 k-vertex Armadillo.
+    small_v, small_t = load_obj(os.path.join(ROOT, "assets", "meshes", "armadillo.obj"))
+    small_c = np.zeros((len(small_v), 3))
+    small_c[np.unique(np.argmin(np.linalg.norm(small_v[:, None] - verts[np.any(c != 0, axis=1)][None, :200], axis=2),
+                                axis=0))] = (1.0, 0.0, 0.0)
+    _, wall, cpu = timed(lambda: _native.diffuse_direction_field(small_v, small_t, small_c))
+    print(f"diffusion on the original {len(small_v)}-vertex Armadillo: {1000 * wall:.0f} ms wall, {1000 * cpu:.0f} ms CPU")
     field = _native.diffuse_direction_field(verts, tris, c)
     edges = field_glyphs.mesh_edges(tris)
 

@@ -5,8 +5,8 @@ mesh, its screen motion turned into a tangent at the hit, and written with a
 screen-space brush radius and a smooth falloff into the painted attribute
 (`exsynth_paint` by default: the one Direction Field's Diffuse mode reads).
 The engine diffuses the constraints into `exsynth_field` on a worker thread
-while the artist paints (the newest constraints win; one diffusion at a
-time), and once more when the stroke ends.
+(the newest constraints win; one diffusion at a time): while the artist
+paints on meshes up to LIVE_DIFFUSION_LIMIT vertices, on release above.
 
 Undo: the whole session is one undo step (Blender's memfile undo reloads the
 mesh datablocks a running tool holds, so steps cannot be pushed mid-tool);
@@ -31,6 +31,12 @@ MODE_NAMES = {'PAINT': "Paint", 'ERASE': "Erase", 'COMB': "Comb"}
 MODE_KEYS = {'P': 'PAINT', 'E': 'ERASE', 'C': 'COMB'}
 MIRROR_KEYS = {'X': 0, 'Y': 1, 'Z': 2}
 UNDO_DEPTH = 64  # strokes Ctrl+Z can take back inside one session
+# Diffuse while the stroke is dragged on meshes up to this size, else on
+# release. Measured (bench/bench_paint.py, 2 cores under load 6-7): one
+# diffusion takes ~0.1 s CPU (0.27 s wall) on the 26 k-vertex Armadillo, live
+# enough; ~0.65 s CPU (1.3-2.4 s wall) once subdivided to 104 k, which would
+# lag the brush by seconds and compete with it for the two cores.
+LIVE_DIFFUSION_LIMIT = 50000
 
 
 def check_target(obj, paint_name):
@@ -161,6 +167,7 @@ class PaintSession:
         self.before_stroke = None
         self.samples = 0
         self.diffuser = Diffuser(self.vertices, self.triangles)
+        self.live = len(self.vertices) <= LIVE_DIFFUSION_LIMIT
 
     @property
     def mesh(self):
@@ -445,7 +452,8 @@ class EXSYNTH_OT_paint_direction_field(bpy.types.Operator):
                 mirror = [k for k in range(3) if settings.field_mirror[k]]
                 self.session.apply(centre, tangent, radius, settings.field_brush_mode, mirror,
                                    settings.field_brush_strength)
-                self.session.request_diffusion()  # the paint attribute is written when the stroke ends
+                if self.session.live:  # the paint attribute is written when the stroke ends
+                    self.session.request_diffusion()
         self.last = (x, y)
 
     # ---- ending ----------------------------------------------------------------
