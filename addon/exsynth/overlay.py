@@ -76,7 +76,7 @@ def field_object(context):
     `exsynth_field`, else None (deleted, not a mesh, no field...)."""
     try:
         obj = context.active_object
-        if obj is None or obj.type != 'MESH' or obj.mode == 'EDIT':
+        if obj is None or obj.type != 'MESH' or obj.mode == 'EDIT' or not obj.visible_get():
             return None
         attr = obj.data.attributes.get(FIELD_ATTRIBUTE)
         if attr is None or (attr.domain, attr.data_type) != ('POINT', 'FLOAT_VECTOR'):
@@ -197,8 +197,23 @@ def _draw():
                  clashes=len(geo["clashes"]), object=obj.name)
 
 
+@bpy.app.handlers.persistent
+def _on_load(_dummy=None):
+    """A file opened (or File › New): the handler follows its scene's toggle."""
+    scene = getattr(bpy.context, "scene", None)
+    settings = getattr(scene, "exsynth", None)
+    if settings is not None:
+        sync(settings)
+
+
 CLASSES = ()
 
 
+def attach():
+    bpy.app.handlers.load_post.append(_on_load)
+
+
 def detach():
+    if _on_load in bpy.app.handlers.load_post:
+        bpy.app.handlers.load_post.remove(_on_load)
     disable()

@@ -247,3 +247,28 @@ def test_compat_names_the_gpu_shaders_for_this_blender():
     expect = "UNIFORM_COLOR" if bpy.app.version >= (4, 0, 0) else "3D_UNIFORM_COLOR"
     assert compat.builtin_shader_name("UNIFORM_COLOR") == expect
     assert compat.builtin_shader_name("POLYLINE_SMOOTH_COLOR").endswith("POLYLINE_SMOOTH_COLOR")
+
+
+def test_overlay_follows_the_toggle_of_an_opened_file(sphere, tmp_path):
+    settings = bpy.context.scene.exsynth
+    settings.field_overlay = True
+    path = str(tmp_path / "overlay_on.blend")
+    bpy.ops.wm.save_as_mainfile(filepath=path, copy=True)
+    settings.field_overlay = False
+    assert not overlay.enabled()
+    bpy.ops.wm.open_mainfile(filepath=path)
+    assert overlay.enabled() and bpy.context.scene.exsynth.field_overlay
+    bpy.ops.wm.read_homefile(use_empty=True)
+    assert not overlay.enabled()
+
+
+def test_overlay_geometry_of_a_faceless_or_hidden_mesh():
+    obj = add_faceless_mesh()
+    attr = obj.data.attributes.new(FIELD, 'FLOAT_VECTOR', 'POINT')
+    attr.data.foreach_set("vector", np.tile([1.0, 0.0, 0.0], 3).astype(np.float32))
+    settings = bpy.context.scene.exsynth
+    assert overlay.field_object(bpy.context) == obj
+    geo = overlay.geometry(obj, settings)
+    assert len(geo["segments"]) == 6 and len(geo["singular"]) == 0
+    obj.hide_set(True)
+    assert overlay.field_object(bpy.context) is None
