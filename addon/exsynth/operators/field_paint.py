@@ -460,7 +460,9 @@ class EXSYNTH_OT_paint_direction_field(bpy.types.Operator):
     def _end(self, context, keep):
         settings = context.scene.exsynth
         overlay.stroking = False
-        context.window_manager.event_timer_remove(self.timer)
+        if self.timer is not None:  # _end may run twice: an error while keeping, then the roll-back
+            context.window_manager.event_timer_remove(self.timer)
+            self.timer = None
         if context.area is not None:
             context.area.header_text_set(None)
         if keep:
