@@ -397,6 +397,8 @@ def paint_tab():
     rv3d.view_distance = 4.5
     settings = bpy.context.scene.exsynth
     settings.field_overlay_max_strokes, settings.field_overlay_length = 500, 1.0  # fewer, longer: readable
+    # The mouse over the sphere (not dragging): the brush circle shows there.
+    win.event_simulate('MOUSEMOVE', 'NOTHING', x=region.x + region.width // 2 + 70, y=region.y + region.height // 2 + 40)
     area.tag_redraw()
     state.update(step="paint_screenshot")
     return 0.5
@@ -408,6 +410,9 @@ def paint_screenshot():
     with bpy.context.temp_override(window=win, screen=win.screen, area=area):
         bpy.ops.screen.screenshot(filepath=SCREENSHOT)
     check(os.path.getsize(SCREENSHOT) > 10000, f"screenshot of the panel and the overlay: {SCREENSHOT}")
+    from exsynth.operators import field_paint
+
+    check(field_paint.cursor_draws > 0, "the brush circle draws under the mouse")
     win.event_simulate('ESC', 'PRESS')
     win.event_simulate('ESC', 'RELEASE')
     state.update(step="paint_ended", t0=time.monotonic())

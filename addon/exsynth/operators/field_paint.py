@@ -22,7 +22,7 @@ import threading
 import bpy
 import numpy as np
 
-from .. import _native, field_brush, overlay
+from .. import _native, compat, field_brush, overlay
 from ..io import mesh as mesh_io
 from ..jobs import REPORTED_ERRORS, InputError
 from .field import FIELD_ATTRIBUTE, check_field_slot, read_vectors
@@ -30,6 +30,7 @@ from .field import FIELD_ATTRIBUTE, check_field_slot, read_vectors
 MODE_NAMES = {'PAINT': "Paint", 'ERASE': "Erase", 'COMB': "Comb"}
 MODE_KEYS = {'P': 'PAINT', 'E': 'ERASE', 'C': 'COMB'}
 MIRROR_KEYS = {'X': 0, 'Y': 1, 'Z': 2}
+cursor_draws = 0  # brush circles drawn (the GUI smoke test reads it)
 UNDO_DEPTH = 64  # strokes Ctrl+Z can take back inside one session
 # Diffuse while the stroke is dragged on meshes up to this size, else on
 # release. Measured (bench/bench_paint.py, 2 cores under load 6-7): one
@@ -346,6 +347,8 @@ class EXSYNTH_OT_paint_direction_field(bpy.types.Operator):
         obj = context.active_object
         self.bvh = BVHTree.FromObject(obj, context.evaluated_depsgraph_get())
         self.stroking, self.last = False, None
+        self.mouse = None  # (region, x, y) for the brush circle
+        self.cursor = bpy.types.SpaceView3D.draw_handler_add(self._draw_cursor, (), 'WINDOW', 'POST_PIXEL')
         self.overlay_was_on = settings.field_overlay
         settings.field_overlay = True
         self.timer = context.window_manager.event_timer_add(0.05, window=context.window)
@@ -365,6 +368,11 @@ class EXSYNTH_OT_paint_direction_field(bpy.types.Operator):
     def _modal(self, context, event):
         settings = context.scene.exsynth
         kind, value = event.type, event.value
+        if kind in {'MOUSEMOVE', 'INBETWEEN_MOUSEMOVE'}:
+            found = _view_region(context, event)
+            self.mouse = None if found is None else (found[0].as_pointer(), found[2], found[3])
+            if context.area is not None:
+                context.area.tag_redraw()
         if kind == 'TIMER':
             if self.session.poll_field():
                 context.area.tag_redraw()
@@ -463,8 +471,12 @@ class EXSYNTH_OT_paint_direction_field(bpy.types.Operator):
         if self.timer is not None:  # _end may run twice: an error while keeping, then the roll-back
             context.window_manager.event_timer_remove(self.timer)
             self.timer = None
+        if self.cursor is not None:
+            bpy.types.SpaceView3D.draw_handler_remove(self.cursor, 'WINDOW')
+            self.cursor = None
         if context.area is not None:
             context.area.header_text_set(None)
+            context.area.tag_redraw()
         if keep:
             self.session.finish()
         else:
@@ -478,6 +490,31 @@ class EXSYNTH_OT_paint_direction_field(bpy.types.Operator):
     def cancel(self, context):
         # Blender ends the tool itself (a file is loaded, the window closes).
         self._end(context, keep=False)
+
+    def _draw_cursor(self):
+        """The brush: a circle of the radius (screen pixels) around the mouse,
+        white for Paint, red for Erase, yellow for Comb."""
+        import gpu
+        from gpu_extras.batch import batch_for_shader
+
+        context = bpy.context
+        if self.mouse is None or context.region is None or context.region.as_pointer() != self.mouse[0]:
+            return
+        settings = context.scene.exsynth
+        r = settings.field_brush_radius
+        angles = np.linspace(0.0, 2.0 * np.pi, 49)
+        points = np.stack([self.mouse[1] + r * np.cos(angles), self.mouse[2] + r * np.sin(angles)], axis=1)
+        colour = {'PAINT': (1.0, 1.0, 1.0, 0.9), 'ERASE': (1.0, 0.3, 0.3, 0.9),
+                  'COMB': (1.0, 0.85, 0.2, 0.9)}[settings.field_brush_mode]
+        shader = compat.builtin_shader('UNIFORM_COLOR', dimensions=2)
+        batch = batch_for_shader(shader, 'LINE_STRIP', {"pos": points.astype(np.float32)})
+        gpu.state.blend_set('ALPHA')
+        shader.bind()
+        shader.uniform_float("color", colour)
+        batch.draw(shader)
+        gpu.state.blend_set('NONE')
+        global cursor_draws
+        cursor_draws += 1
 
     def _header(self, context, note=""):
         s = context.scene.exsynth
