@@ -33,10 +33,11 @@ MIRROR_KEYS = {'X': 0, 'Y': 1, 'Z': 2}
 cursor_draws = 0  # brush circles drawn (the GUI smoke test reads it)
 UNDO_DEPTH = 64  # strokes Ctrl+Z can take back inside one session
 # Diffuse while the stroke is dragged on meshes up to this size, else on
-# release. Measured (bench/bench_paint.py, 2 cores under load 6-7): one
-# diffusion takes ~0.1 s CPU (0.27 s wall) on the 26 k-vertex Armadillo, live
-# enough; ~0.65 s CPU (1.3-2.4 s wall) once subdivided to 104 k, which would
-# lag the brush by seconds and compete with it for the two cores.
+# release. Measured (bench/bench_paint.py, 2 cores): one diffusion takes
+# ~0.1 s CPU (85 ms wall at load 1.5, 0.27 s at load 6) on the 26 k-vertex
+# Armadillo, live enough; once subdivided to 104 k, 0.43 s wall at load 1.5
+# and 1.3-2.4 s at load 6, which would lag the brush and compete with it for
+# the two cores.
 LIVE_DIFFUSION_LIMIT = 50000
 
 
