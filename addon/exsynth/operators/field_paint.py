@@ -87,10 +87,15 @@ class Diffuser:
         self._thread, self._pending, self._result = None, None, None
         self._lock = threading.Lock()
         self.runs, self.error = 0, None
+        self.requested = None  # the constraints of the last request (main thread only)
 
     def request(self, constraints):
+        """Diffuse these constraints next (not again if they are the last ones asked for)."""
+        if self.requested is not None and np.array_equal(constraints, self.requested):
+            return
+        self.requested = constraints.copy()
         with self._lock:
-            self._pending = constraints.copy()
+            self._pending = self.requested
         self._start_if_idle()
 
     def _start_if_idle(self):
@@ -377,6 +382,10 @@ class EXSYNTH_OT_paint_direction_field(bpy.types.Operator):
         if kind == 'TIMER':
             if self.session.poll_field():
                 context.area.tag_redraw()
+            error = self.session.diffuser.error
+            if error is not None:  # shown, not fatal: the next stroke may fix it
+                self.session.diffuser.error = None
+                self._header(context, f"field not updated: {error}")
             return {'PASS_THROUGH'}
         if self.stroking:
             if kind in {'MOUSEMOVE', 'INBETWEEN_MOUSEMOVE'}:
