@@ -62,6 +62,7 @@ def test_a_stroke_paints_and_diffuses_along_its_direction(sphere):
     # Around the equator's front (world -y side), running along world x.
     stroke(session, sphere, (1.0, 0.0, -1.0), (3.0, 0.0, -1.0))
     session.finish()
+    assert session.diffuser.runs == 1  # the release's diffusion is not repeated by finish()
     paint, field = vectors(sphere, PAINT), vectors(sphere, FIELD)
     painted = np.any(paint != 0, axis=1)
     assert 20 < painted.sum() < len(paint) / 2
