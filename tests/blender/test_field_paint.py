@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from exsynth import field_brush, overlay
-from exsynth.operators import field_paint
+from exsynth.operators import field_paint_session
 from helpers import add_camera, add_faceless_mesh, scene_state
 
 FIELD, PAINT = "exsynth_field", "exsynth_paint"
@@ -58,7 +58,7 @@ def stroke(session, obj, start, end, samples=12, radius=0.3, mode='PAINT', mirro
 
 
 def test_a_stroke_paints_and_diffuses_along_its_direction(sphere):
-    session = field_paint.PaintSession(sphere, PAINT)
+    session = field_paint_session.PaintSession(sphere, PAINT)
     # Around the equator's front (world -y side), running along world x.
     stroke(session, sphere, (1.0, 0.0, -1.0), (3.0, 0.0, -1.0))
     session.finish()
@@ -83,7 +83,7 @@ def test_a_stroke_paints_and_diffuses_along_its_direction(sphere):
 
 
 def test_mirror_paints_the_mirrored_side_with_the_mirrored_direction(sphere):
-    session = field_paint.PaintSession(sphere, PAINT)
+    session = field_paint_session.PaintSession(sphere, PAINT)
     # On the local +x side (world x = 2 + 1.5), running along local +z then mirrored across local x.
     session.begin_stroke()
     for z in np.linspace(-0.3, 0.3, 8):
@@ -103,7 +103,7 @@ def test_mirror_paints_the_mirrored_side_with_the_mirrored_direction(sphere):
 
 
 def test_erase_removes_constraints_and_comb_bends_the_field(sphere):
-    session = field_paint.PaintSession(sphere, PAINT)
+    session = field_paint_session.PaintSession(sphere, PAINT)
     stroke(session, sphere, (1.0, 0.0, -1.0), (3.0, 0.0, -1.0))
     before = np.count_nonzero(np.any(session.constraints != 0, axis=1))
     stroke(session, sphere, (1.6, 0.0, -1.0), (2.4, 0.0, -1.0), mode='ERASE', radius=0.25)
@@ -120,7 +120,7 @@ def test_erase_removes_constraints_and_comb_bends_the_field(sphere):
 
 
 def test_in_tool_undo_and_stroke_cancel(sphere):
-    session = field_paint.PaintSession(sphere, PAINT)
+    session = field_paint_session.PaintSession(sphere, PAINT)
     stroke(session, sphere, (1.0, 0.0, -1.0), (3.0, 0.0, -1.0))
     first = session.constraints.copy()
     stroke(session, sphere, (2.0, 0.0, -2.0), (2.0, 0.0, 0.0))
@@ -140,7 +140,7 @@ def test_cancel_restores_the_attributes(sphere):
     bpy.context.scene.exsynth.field_preset = 'AROUND_AXIS'
     assert bpy.ops.exsynth.direction_field() == {'FINISHED'}
     before = state(sphere)
-    session = field_paint.PaintSession(sphere, PAINT)
+    session = field_paint_session.PaintSession(sphere, PAINT)
     stroke(session, sphere, (1.0, 0.0, -1.0), (3.0, 0.0, -1.0))
     session.finish()
     assert state(sphere) != before and session.changed()
@@ -150,7 +150,7 @@ def test_cancel_restores_the_attributes(sphere):
 
 def test_cancel_removes_attributes_it_created(sphere):
     before = state(sphere)
-    session = field_paint.PaintSession(sphere, PAINT)
+    session = field_paint_session.PaintSession(sphere, PAINT)
     stroke(session, sphere, (1.0, 0.0, -1.0), (3.0, 0.0, -1.0))
     session.finish()
     assert PAINT in sphere.data.attributes and FIELD in sphere.data.attributes
@@ -160,7 +160,7 @@ def test_cancel_removes_attributes_it_created(sphere):
 
 def test_undo_after_painting_restores_the_field(sphere):
     bpy.ops.ed.undo_push(message="before painting")
-    session = field_paint.PaintSession(sphere, PAINT)
+    session = field_paint_session.PaintSession(sphere, PAINT)
     stroke(session, sphere, (1.0, 0.0, -1.0), (3.0, 0.0, -1.0))
     session.finish()
     bpy.ops.ed.undo_push(message="Paint Direction Field")
@@ -203,7 +203,7 @@ def test_headless_call_says_it_is_interactive(sphere):
 
 def test_zero_brush_radius_changes_nothing(sphere):
     before = state(sphere)
-    session = field_paint.PaintSession(sphere, PAINT)
+    session = field_paint_session.PaintSession(sphere, PAINT)
     for radius in (0.0, -1.0, float("nan")):
         with pytest.raises(ValueError, match="brush radius must be a positive number"):
             session.apply(world(sphere)[0], (1.0, 0.0, 0.0), radius)
