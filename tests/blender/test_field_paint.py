@@ -273,3 +273,27 @@ def test_overlay_geometry_of_a_faceless_or_hidden_mesh():
     assert len(geo["segments"]) == 6 and len(geo["singular"]) == 0
     obj.hide_set(True)
     assert overlay.field_object(bpy.context) is None
+
+
+def test_strokes_start_only_over_the_open_viewport_not_its_sidebar():
+    from types import SimpleNamespace as NS
+
+    from exsynth.operators import field_paint
+
+    # A 3D viewport 1000 x 600 at (100, 50) whose sidebar (300 wide) and header overlap its main region.
+    window = NS(type='WINDOW', x=100, y=50, width=1000, height=600)
+    sidebar = NS(type='UI', x=800, y=50, width=300, height=570)
+    header = NS(type='HEADER', x=100, y=620, width=1000, height=30)
+    hidden = NS(type='TOOLS', x=100, y=50, width=1, height=600)  # a closed toolbar is 1 pixel wide
+    area = NS(type='VIEW_3D', regions=[header, hidden, sidebar, window], spaces=NS(active=NS(region_3d="rv3d")))
+    context = NS(area=area)
+
+    def at(x, y):
+        return field_paint._view_region(context, NS(mouse_x=x, mouse_y=y))
+
+    assert at(400, 300) == (window, "rv3d", 300, 250)
+    assert at(100, 300) == (window, "rv3d", 0, 250)  # over the closed toolbar
+    assert at(900, 300) is None  # over the sidebar
+    assert at(400, 630) is None  # over the header
+    assert at(50, 300) is None  # outside the area
+    assert field_paint._view_region(NS(area=None), NS(mouse_x=400, mouse_y=300)) is None

@@ -36,12 +36,17 @@ def _view_region(context, event):
     area = context.area
     if area is None or area.type != 'VIEW_3D':
         return None
-    for region in area.regions:
-        if region.type != 'WINDOW':
-            continue
+    def inside(region):
         x, y = event.mouse_x - region.x, event.mouse_y - region.y
-        if 0 <= x < region.width and 0 <= y < region.height:
-            return region, area.spaces.active.region_3d, x, y
+        return region.width > 1 and 0 <= x < region.width and 0 <= y < region.height
+
+    # With Region Overlap (the default) the sidebar, toolbar and headers lie
+    # over the main region: the mouse there is for their buttons.
+    if any(r.type != 'WINDOW' and inside(r) for r in area.regions):
+        return None
+    for region in area.regions:
+        if region.type == 'WINDOW' and inside(region):
+            return region, area.spaces.active.region_3d, event.mouse_x - region.x, event.mouse_y - region.y
     return None
 
 
