@@ -3,7 +3,7 @@
 
 import bpy
 from bpy.props import (
-    BoolProperty, EnumProperty, FloatProperty, IntProperty, PointerProperty, StringProperty,
+    BoolProperty, BoolVectorProperty, EnumProperty, FloatProperty, IntProperty, PointerProperty, StringProperty,
 )
 
 GIB = 1 << 30
@@ -14,6 +14,12 @@ FIELD_PRESET_ITEMS = (
     ('ALONG_AXIS', "Along Axis", "The axis, laid flat onto the surface"),
     ('ALONG_CURVE', "Along Curve", "The direction of the nearest point of a curve object"),
 )
+
+
+def _overlay_sync(settings, context):
+    from . import overlay  # the overlay module imports gpu helpers: load it on first use
+
+    overlay.sync(settings, context)
 
 
 class ExSynthSettings(bpy.types.PropertyGroup):
@@ -164,6 +170,44 @@ class ExSynthSettings(bpy.types.PropertyGroup):
         description="The Vector attribute on the Vertex domain holding painted directions "
         "(zero vectors are free and get filled in)",
         default="exsynth_paint",
+    )
+    # Painting (Paint Direction Field) and the field overlay.
+    field_brush_mode: EnumProperty(
+        name="Brush",
+        description="What a stroke does (keys P, E, C while painting)",
+        items=(('PAINT', "Paint", "Set the directions under the brush to the stroke's"),
+               ('ERASE', "Erase", "Remove the painted directions under the brush (the field is diffused again)"),
+               ('COMB', "Comb", "Drag the existing directions under the brush along the stroke, a little per sample")),
+        default='PAINT',
+    )
+    field_brush_radius: IntProperty(
+        name="Radius", description="Brush radius in screen pixels (keys [ and ] while painting)",
+        default=40, min=1, max=1000, soft_max=300, subtype='PIXEL',
+    )
+    field_brush_strength: FloatProperty(
+        name="Strength", description="How far a sample turns the directions at the brush centre (1: fully)",
+        default=1.0, min=0.01, max=1.0,
+    )
+    field_mirror: BoolVectorProperty(
+        name="Mirror", description="Also paint the stroke mirrored across the mesh's local X, Y or Z axis "
+        "(keys X, Y, Z while painting)", size=3, subtype='XYZ', default=(False, False, False),
+    )
+    field_overlay: BoolProperty(
+        name="Show Field", description="Draw the active mesh's 'exsynth_field' in the viewport as short "
+        "strokes (dark tail, yellow head), singular points red, clashing neighbours orange",
+        default=False, update=_overlay_sync,
+    )
+    field_overlay_max_strokes: IntProperty(
+        name="Strokes", description="At most this many strokes (every n-th vertex)",
+        default=4000, min=10, max=500000, soft_max=50000,
+    )
+    field_overlay_length: FloatProperty(
+        name="Length", description="Stroke length as a fraction of the spacing between strokes",
+        default=0.8, min=0.05, max=10.0, soft_max=3.0,
+    )
+    field_overlay_singularities: BoolProperty(
+        name="Singularities", description="Mark where the field is undefined or turns around a point (red) "
+        "and where neighbouring directions clash (orange)", default=True,
     )
 
     # ---- Geometric Texture ---------------------------------------------------

@@ -3,7 +3,10 @@
 invoke from a 3D viewport, watch progress, finish; invoke again, press Esc
 mid-run, check the scene is unchanged; then open the sidebar's ExSynth tab
 (the Solid Texture panels must draw) and run Solid Texture modally; run
-Geometric Texture modally (its panel must draw) and undo it. Needs a display, e.g. (xvfb package):
+Geometric Texture modally (its panel must draw) and undo it; Point Texture
+likewise; then paint a direction field: the overlay draws, a simulated
+stroke turns the field its way, Esc ends, undo restores it, and a
+screenshot goes to $EXSYNTH_SCREENSHOT (default build/gui_paint.png). Needs a display, e.g. (xvfb package):
 
     EXSYNTH_ADDON_DIR=build/addon xvfb-run -a -s "-screen 0 1280x800x24" \
         blender --factory-startup --enable-event-simulate --python tests/blender/gui_smoke.py
@@ -18,6 +21,7 @@ import traceback
 
 import addon_utils
 import bpy
+import numpy as np
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 sys.path.insert(0, os.environ.get("EXSYNTH_ADDON_DIR", os.path.join(ROOT, "build", "addon")))
@@ -30,7 +34,9 @@ def _raise(exc):
 addon_utils.enable("exsynth", default_set=True, handle_error=_raise)
 from exsynth import jobs  # noqa: E402  (needs the path set above)
 
-state = {"step": "start", "ctx": None, "t0": 0.0}
+# EXSYNTH_GUI_FROM=paint_start runs only the last part (when working on it).
+state = {"step": os.environ.get("EXSYNTH_GUI_FROM", "start"), "ctx": None, "t0": 0.0}
+FROM_START = state["step"] == "start"
 jobs.job_started_hooks.append(lambda ctx: state.update(ctx=ctx))
 
 
@@ -250,6 +256,182 @@ def pts_finish():
 
 def pts_undone():
     check(names() == [], "one undo removes the Point Texture result")
+    state.update(step="paint_start")
+    return 0.1
+
+
+# ---- Paint Direction Field: the overlay draws, a simulated stroke turns the
+# field its way, Esc ends the tool, one undo restores the field; a screenshot
+SCREENSHOT = os.environ.get("EXSYNTH_SCREENSHOT", os.path.join(ROOT, "build", "gui_paint.png"))
+
+
+def _viewport():
+    win = bpy.context.window_manager.windows[0]
+    area = next(a for a in win.screen.areas if a.type == 'VIEW_3D')
+    return win, area, next(r for r in area.regions if r.type == 'WINDOW')
+
+
+def _field():
+    obj = bpy.data.objects["Sphere"]
+    out = np.empty(3 * len(obj.data.vertices), np.float32)
+    obj.data.attributes["exsynth_field"].data.foreach_get("vector", out)
+    return out.reshape(-1, 3)
+
+
+def _along_stroke():
+    """Mean dot product, near the stroke, of the field with world +x laid
+    into the tangent plane (the stroke runs left to right in a top view)."""
+    from exsynth import field_brush
+
+    obj = bpy.data.objects["Sphere"]
+    co = np.empty(3 * len(obj.data.vertices), np.float32)
+    obj.data.vertices.foreach_get("co", co)
+    co = co.reshape(-1, 3)
+    near = (co[:, 2] > 0.3) & (np.abs(co[:, 1]) < 0.15) & (np.abs(co[:, 0]) < 0.5)
+    expect = field_brush.project_tangent([1.0, 0.0, 0.0], field_brush.normalized(co[near]))
+    return float(np.mean(np.sum(_field()[near] * expect, axis=1))), int(near.sum())
+
+
+def paint_start():
+    from exsynth import overlay
+
+    bpy.data.batch_remove(list(bpy.data.objects))
+    _in_viewport(lambda: bpy.ops.mesh.primitive_uv_sphere_add(segments=64, ring_count=32, radius=1.0))
+    settings = bpy.context.scene.exsynth
+    settings.field_mode, settings.field_preset, settings.field_axis = 'PRESET', 'ALONG_AXIS', 'Y'
+    check(bpy.ops.exsynth.direction_field() == {'FINISHED'}, "a preset field along Y to paint over")
+    win, area, region = _viewport()
+    area.spaces.active.show_region_ui = True
+    if not FROM_START:  # the splash is still open and takes the mouse: Esc closes it
+        win.event_simulate('ESC', 'PRESS')
+        win.event_simulate('ESC', 'RELEASE')
+    rv3d = area.spaces.active.region_3d
+    rv3d.view_perspective = 'ORTHO'
+    rv3d.view_rotation = (1.0, 0.0, 0.0, 0.0)  # top view: screen right = world +x, up = +y
+    rv3d.view_location = (0.0, 0.0, 0.0)
+    rv3d.view_distance = 3.0
+    # For the picture: the Direction Field panel alone in the tab, open (the
+    # other panels were drawn and checked above).
+    from exsynth import panels
+
+    others = [c for c in panels.CLASSES if c.__name__ != "EXSYNTH_PT_field"]
+    for cls in sorted(others, key=lambda c: not getattr(c, "bl_parent_id", "")):  # sub-panels first
+        bpy.utils.unregister_class(cls)
+    _record_draws(bpy.types.EXSYNTH_PT_field)
+    overlay.stats.update(draws=0, vertices=0)
+    settings.field_overlay = True
+    settings.field_overlay_max_strokes = 1500
+    area.tag_redraw()
+    state.update(step="paint_overlay", t0=time.monotonic())
+    return 0.3
+
+
+def paint_overlay():
+    from exsynth import overlay
+
+    if overlay.stats["draws"] == 0 or overlay.stats["vertices"] == 0:
+        if time.monotonic() - state["t0"] > 10:
+            check(False, "the field overlay draws strokes")
+        _viewport()[1].tag_redraw()
+        return 0.1
+    check(overlay.stats["object"] == "Sphere" and overlay.stats["vertices"] > 1000,
+          f"the field overlay draws strokes ({overlay.stats['vertices'] // 2} strokes)")
+    check(overlay.stats["singular"] >= 2, f"the overlay marks the poles of the field along Y as singular "
+          f"({overlay.stats['singular']} points)")
+    before, n = _along_stroke()
+    check(abs(before) < 0.2 and n > 10, f"before painting the field crosses the stroke (mean dot {before:.2f})")
+    state["field_before"] = _field().copy()
+    _in_viewport(lambda: bpy.ops.ed.undo_push(message="before painting"))
+    check(invoke_in_viewport("paint_direction_field") == {'RUNNING_MODAL'}, "Paint Direction Field runs modal")
+    win, area, region = _viewport()
+    cx, cy = region.x + region.width // 2, region.y + region.height // 2
+    win.event_simulate('MOUSEMOVE', 'NOTHING', x=cx - 120, y=cy)
+    win.event_simulate('LEFTMOUSE', 'PRESS', x=cx - 120, y=cy)
+    for dx in range(-110, 121, 10):
+        win.event_simulate('MOUSEMOVE', 'NOTHING', x=cx + dx, y=cy)
+    state.update(step="paint_release", release=(cx + 120, cy))
+    return 0.2
+
+
+def paint_release():
+    win = _viewport()[0]
+    x, y = state["release"]
+    win.event_simulate('LEFTMOUSE', 'RELEASE', x=x, y=y)
+    state.update(step="paint_diffused", t0=time.monotonic())
+    return 0.3
+
+
+def paint_diffused():
+    dot, _ = _along_stroke()
+    if dot < 0.8:
+        if time.monotonic() - state["t0"] > 30:
+            check(False, f"the stroke turns the field its way while the tool runs (mean dot {dot:.2f})")
+        return 0.2
+    check(True, f"the stroke turns the field its way while the tool runs (mean dot {dot:.2f})")
+    drawn.discard("EXSYNTH_PT_field")
+    _viewport()[1].tag_redraw()
+    state.update(step="paint_tab", tabs=0)
+    return 0.3
+
+
+def paint_tab():
+    """The sidebar on the ExSynth tab (stepping through tabs with Ctrl+Wheel
+    when this part runs alone), then a three-quarter view for the picture."""
+    from mathutils import Euler
+
+    win, area, region = _viewport()
+    if "EXSYNTH_PT_field" not in drawn:
+        if state["tabs"] >= 8:
+            check(False, "the Direction Field panel draws while painting")
+        ui = next(r for r in area.regions if r.type == 'UI')
+        x, y = ui.x + ui.width - 8, ui.y + ui.height - 60
+        win.event_simulate('MOUSEMOVE', 'NOTHING', x=x, y=y)
+        win.event_simulate('WHEELDOWNMOUSE', 'PRESS', x=x, y=y, ctrl=True)
+        area.tag_redraw()
+        state["tabs"] += 1
+        return 0.3
+    check(True, "the Direction Field panel draws while painting")
+    rv3d = area.spaces.active.region_3d
+    rv3d.view_perspective = 'PERSP'
+    rv3d.view_rotation = Euler((0.9, 0.0, 0.5)).to_quaternion()
+    rv3d.view_distance = 4.5
+    settings = bpy.context.scene.exsynth
+    settings.field_overlay_max_strokes, settings.field_overlay_length = 500, 1.0  # fewer, longer: readable
+    # The mouse over the sphere (not dragging): the brush circle shows there.
+    win.event_simulate('MOUSEMOVE', 'NOTHING', x=region.x + region.width // 2 + 70, y=region.y + region.height // 2 + 40)
+    area.tag_redraw()
+    state.update(step="paint_screenshot")
+    return 0.5
+
+
+def paint_screenshot():
+    win, area, region = _viewport()
+    os.makedirs(os.path.dirname(SCREENSHOT), exist_ok=True)
+    with bpy.context.temp_override(window=win, screen=win.screen, area=area):
+        bpy.ops.screen.screenshot(filepath=SCREENSHOT)
+    check(os.path.getsize(SCREENSHOT) > 10000, f"screenshot of the panel and the overlay: {SCREENSHOT}")
+    from exsynth.operators import field_paint
+
+    check(field_paint.cursor_draws > 0, "the brush circle draws under the mouse")
+    win.event_simulate('ESC', 'PRESS')
+    win.event_simulate('ESC', 'RELEASE')
+    state.update(step="paint_ended", t0=time.monotonic())
+    return 0.5
+
+
+def paint_ended():
+    dot, _ = _along_stroke()
+    check(dot > 0.8, f"Esc ends the tool and keeps the stroke (mean dot with the stroke {dot:.2f})")
+    check("exsynth_paint" in bpy.data.objects["Sphere"].data.attributes, "the stroke is in 'exsynth_paint'")
+    _in_viewport(lambda: bpy.ops.ed.undo())
+    state.update(step="paint_undone")
+    return 0.3
+
+
+def paint_undone():
+    obj = bpy.data.objects["Sphere"]
+    check(np.array_equal(_field(), state["field_before"]) and "exsynth_paint" not in obj.data.attributes,
+          "one undo restores the field and removes the paint")
     print("gui_smoke: all passed", flush=True)
     os._exit(0)
 
@@ -258,5 +440,8 @@ STEPS = {"start": start, "wait_finish": wait_finish, "press_esc": press_esc, "af
          "solid_start": solid_start, "find_tab": find_tab, "solid_finish": solid_finish,
          "geo_start": geo_start, "geo_finish": geo_finish, "geo_undone": geo_undone,
          "geo_pair_drawn": geo_pair_drawn, "pts_start": pts_start, "pts_finish": pts_finish,
-         "pts_undone": pts_undone}
+         "pts_undone": pts_undone, "paint_start": paint_start, "paint_overlay": paint_overlay,
+         "paint_release": paint_release, "paint_diffused": paint_diffused, "paint_tab": paint_tab,
+         "paint_screenshot": paint_screenshot,
+         "paint_ended": paint_ended, "paint_undone": paint_undone}
 bpy.app.timers.register(step, first_interval=1.0)

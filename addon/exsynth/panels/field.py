@@ -11,7 +11,6 @@ class EXSYNTH_PT_field(bpy.types.Panel):
     bl_space_type = 'VIEW_3D'
     bl_region_type = 'UI'
     bl_category = CATEGORY
-    bl_options = {'DEFAULT_CLOSED'}
 
     def draw(self, context):
         layout = self.layout
@@ -42,6 +41,31 @@ class EXSYNTH_PT_field(bpy.types.Panel):
         row = layout.row()
         row.scale_y = 1.4
         row.operator("exsynth.direction_field", icon='ORIENTATION_NORMAL')
+
+        # Painting: strokes into the painted attribute, diffused as you go.
+        box = layout.box()
+        col = box.column()
+        col.prop(settings, "field_brush_mode")
+        col.prop(settings, "field_brush_radius")
+        col.prop(settings, "field_brush_strength")
+        row = col.row(heading="Mirror", align=True)
+        for k, axis in enumerate("XYZ"):
+            row.prop(settings, "field_mirror", index=k, text=axis, toggle=True)
+        row = box.row()
+        row.scale_y = 1.3
+        row.operator("exsynth.paint_direction_field", icon='BRUSH_DATA')
+        box.label(text="Drag on the mesh", icon='INFO')
+
+        # The overlay: drawn from 'exsynth_field' whatever made it.
+        box = layout.box()
+        box.prop(settings, "field_overlay", icon='HIDE_OFF' if settings.field_overlay else 'HIDE_ON')
+        if settings.field_overlay:
+            col = box.column()
+            col.prop(settings, "field_overlay_max_strokes")
+            col.prop(settings, "field_overlay_length")
+            col.prop(settings, "field_overlay_singularities")
+            if mesh is not None and mesh.attributes.get("exsynth_field") is None:
+                box.label(text="No 'exsynth_field' on this mesh yet", icon='INFO')
 
 
 CLASSES = (EXSYNTH_PT_field,)
