@@ -18,6 +18,12 @@ bl_info = {
     "category": "ExSynth",
 }
 
+# A packaged add-on (./exsynth package) binds its module to the libraries it
+# bundles, not to Blender's copies of Embree/OpenVDB (see native_loader.py).
+from . import native_loader as _native_loader  # noqa: E402
+
+_native_loader.load_bundled()
+
 # Registration order matters: the PropertyGroup before anything that reads it.
 _MODULES = ("properties", "operators", "panels")
 
@@ -36,7 +42,8 @@ def register():
     except ImportError as exc:
         raise ImportError(
             "exsynth: the compiled module exsynth._native is missing or does not load "
-            f"({exc}). Build it with `./exsynth build` and enable the add-on from build/addon/."
+            f"({exc}). Build it with `./exsynth build` and enable the add-on from build/addon/, "
+            "or install the zip from `./exsynth package` (Linux x64, Blender with Python 3.11)."
         ) from exc
 
     done, attached = [], []

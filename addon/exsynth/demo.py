@@ -275,7 +275,9 @@ def _ensure_addon():
     def raise_error(exc):
         raise exc
 
-    addon_utils.enable("exsynth", default_set=True, handle_error=raise_error)
+    # The add-on's own module name: "exsynth", or "bl_ext.REPO.exsynth" when
+    # installed as an extension.
+    addon_utils.enable(__package__, default_set=True, handle_error=raise_error)
 
 
 def _stage(scene, samples):
