@@ -12,6 +12,7 @@ import bpy
 import numpy as np
 from mathutils import Vector
 
+from . import compat
 from .io import materials
 from .io import mesh as mesh_io
 from .io.selection import select_only
@@ -294,8 +295,7 @@ def _stage(scene, samples):
     scene.view_settings.look = 'Medium Contrast'
 
     world = bpy.data.worlds.new("Demo World")
-    world.use_nodes = True
-    background = world.node_tree.nodes["Background"]
+    background = compat.ensure_node_tree(world).nodes["Background"]
     background.inputs["Color"].default_value = (0.30, 0.36, 0.46, 1.0)
     background.inputs["Strength"].default_value = 0.5
     scene.world = world

@@ -6,7 +6,15 @@ from bpy.props import (
     BoolProperty, EnumProperty, FloatProperty, IntProperty, PointerProperty, StringProperty,
 )
 
+from . import _native
+
 GIB = 1 << 30
+
+# The engine's size rule for solids (the coarsest level holds one
+# neighbourhood): a property's min cannot follow Levels, so the hard min is
+# what one level allows and the soft min what the default 3 levels need; the
+# operator checks the pair (operators/solid.py check_size).
+SOLID_DEFAULT_LEVELS = 3
 
 # The direction-field presets (Direction Field and Geometric Texture).
 FIELD_PRESET_ITEMS = (
@@ -78,14 +86,17 @@ class ExSynthSettings(bpy.types.PropertyGroup):
     )
     solid_size: IntProperty(
         name="Size",
-        description="Voxels along each edge of the solid (it is Size × Size × Size and tiles)",
-        default=64, min=16, max=256,
+        description="Voxels along each edge of the solid (it is Size × Size × Size and tiles); "
+        f"at least {_native.min_texture_size(SOLID_DEFAULT_LEVELS)} with {SOLID_DEFAULT_LEVELS} Levels, "
+        f"{_native.min_texture_size(1)} with 1",
+        default=64, min=_native.min_texture_size(1), soft_min=_native.min_texture_size(SOLID_DEFAULT_LEVELS),
+        max=256,
     )
     solid_levels: IntProperty(
         name="Levels",
         description="Coarse-to-fine levels; the coarsest (Size / 2^(Levels-1)) and the exemplar at "
         "that level must be at least 8 pixels across",
-        default=3, min=1, max=6,
+        default=SOLID_DEFAULT_LEVELS, min=1, max=6,
     )
     solid_iterations: IntProperty(
         name="Iterations",
