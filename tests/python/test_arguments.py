@@ -43,7 +43,8 @@ FUNCTIONS = {
         "voxel_size": ("real", 0, None), "compute_sdf": "bool", "memory_budget": "budget", "seed": "seed",
         "ctx": "ctx"}),
     "model_thickness": (call("model_thickness", VERTS, FACES, resolution=16), {
-        "resolution": ("int", 16, 1024), "percentile": ("real", 0, 100), "memory_budget": "budget", "seed": "seed",
+        "resolution": ("int", 16, 1024), "percentile": ("real", 0, 100),
+        "pattern_per_thickness": ("real", 0, 100), "memory_budget": "budget", "seed": "seed",
         "ctx": "ctx"}),
     "volume_frames": (call("volume_frames", SDF, [0, 0, 0], 1.0, PTS, DIRS), {
         "band": ("real", 0, None), "smoothing_steps": ("int", 0, 1000), "ctx": "ctx"}),

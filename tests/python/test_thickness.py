@@ -29,6 +29,7 @@ def test_slab_and_cylinder_measure_their_thin_side():
     for r in (slab, tube):
         assert r["low"] <= r["median"] <= r["high"] and r["samples"] > 500
         assert r["median"] == r["thickness"]  # the default percentile is the median
+        assert r["pattern_size"] == pytest.approx(2 * r["thickness"])
 
 
 def test_percentile_picks_among_the_samples():

@@ -17,9 +17,16 @@
 
 namespace exsynth {
 
+/// Option limits, checked by model_thickness (exported for the bindings).
+constexpr int kMinThicknessResolution = 16, kMaxThicknessResolution = 1024;
+
 struct ThicknessOptions {
   int resolution = 96;       ///< voxels along the longest bounding-box side (16..1024)
   double percentile = 50.0;  ///< of the surface samples' diameters, in [0, 100]
+  /// The pattern (a built-in pair's cube) spans this many thicknesses:
+  /// chosen by looking at Geometric Texture on the armadillo, bunny and cow
+  /// (docs/analogy.md); 2 gives the bunny about the old half of its side.
+  double pattern_per_thickness = 2.0;
   std::size_t memory_budget = kDefaultMemoryBudget;
   std::uint64_t seed = 0;    ///< unused: the measure is deterministic
 };
@@ -29,6 +36,7 @@ struct ThicknessResult {
   double voxel_size = 0.0;   ///< of the signed-distance grid it was measured on
   std::size_t samples = 0;   ///< surface samples (voxels just inside the surface)
   double median = 0.0, low = 0.0, high = 0.0;  ///< 50th, 10th, 90th percentiles
+  double pattern_size = 0.0;  ///< thickness * pattern_per_thickness: the default pattern size
 };
 
 /// Measures `mesh` (closed, as voxelize wants it). Throws InvalidInput for

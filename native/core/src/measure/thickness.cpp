@@ -13,7 +13,7 @@
 namespace exsynth {
 namespace {
 
-constexpr int kMinResolution = 16, kMaxResolution = 1024;
+constexpr int kMinResolution = kMinThicknessResolution, kMaxResolution = kMaxThicknessResolution;
 
 // Signed distance at a world point, trilinear between voxel centres; outside
 // the grid it is clamped, which only shortens a walk that left the model.
@@ -95,6 +95,9 @@ ThicknessResult model_thickness(const TriangleMesh& mesh, const ThicknessOptions
                        std::to_string(kMaxResolution) + " (got " + std::to_string(opt.resolution) + ")");
   if (!(opt.percentile >= 0.0 && opt.percentile <= 100.0))
     throw InvalidInput("thickness: percentile must be in [0, 100] (got " + std::to_string(opt.percentile) + ")");
+  if (!(opt.pattern_per_thickness > 0.0 && opt.pattern_per_thickness <= 100.0))
+    throw InvalidInput("thickness: pattern_per_thickness must be in (0, 100] (got " +
+                       std::to_string(opt.pattern_per_thickness) + ")");
   VoxelizeOptions vopt;
   vopt.resolution = opt.resolution;
   vopt.padding = 2;
@@ -115,6 +118,7 @@ ThicknessResult model_thickness(const TriangleMesh& mesh, const ThicknessOptions
   r.median = percentile_of(d, 50.0);
   r.low = percentile_of(d, 10.0);
   r.high = percentile_of(d, 90.0);
+  r.pattern_size = r.thickness * opt.pattern_per_thickness;
   return r;
 }
 
