@@ -25,7 +25,7 @@ from . import native_loader as _native_loader  # noqa: E402
 _native_loader.load_bundled()
 
 # Registration order matters: the PropertyGroup before anything that reads it.
-_MODULES = ("properties", "operators", "panels")
+_MODULES = ("properties", "operators", "panels", "ui")
 
 
 def _modules():

@@ -176,6 +176,7 @@ def run_analogy(bunny_path, out_dir, resolution=128, pattern_size=0.4, samples=1
     if bpy.ops.exsynth.direction_field() != {'FINISHED'}:
         raise RuntimeError("exsynth.direction_field did not finish")
     settings.geo_resolution = resolution
+    settings.geo_pattern_fit = False  # the demo's figures are made at a set size
     settings.geo_pattern_scale = pattern_size
     made, seconds = {}, {}
     colours = {'SPIKES': (0.72, 0.42, 0.22), 'PITS': (0.45, 0.62, 0.38), 'HOLES': (0.62, 0.52, 0.70),

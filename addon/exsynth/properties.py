@@ -247,12 +247,24 @@ class ExSynthSettings(bpy.types.PropertyGroup):
         "with its cube)",
         default=128, min=16, max=512, soft_max=256,
     )
+    geo_pattern_fit: BoolProperty(
+        name="Fit to Model",
+        description="Built-in pairs: size the pattern from the mesh's own thickness (twice the median "
+        "diameter of the balls that fit inside it at its surface), so thin parts get features that "
+        "fit them; the size is shown in the panel and in the viewport. Off: set Pattern Size by hand",
+        default=True,
+    )
     geo_pattern_scale: FloatProperty(
         name="Pattern Size",
-        description="Built-in pairs: how much of the mesh one exemplar cube covers, as a fraction of "
-        "its longest side (smaller: smaller, denser features). The pair is made at Resolution × "
-        "Pattern Size voxels, 8 to 512",
+        description="Built-in pairs, Fit to Model off: how much of the mesh one exemplar cube covers, "
+        "as a fraction of its longest side (smaller: smaller, denser features). The pair is made at "
+        "Resolution × Pattern Size voxels, 8 to 512",
         default=0.5, min=0.05, max=4.0, soft_max=2.0, precision=2,
+    )
+    geo_show_pattern: BoolProperty(
+        name="Show Pattern Size",
+        description="Draw a wire sphere of the pattern's size at the active mesh in the 3D viewport",
+        default=True,
     )
     geo_dilation: FloatProperty(
         name="Dilation",
