@@ -15,7 +15,9 @@ needed. Excluded: what the manylinux policy assumes every Linux has (glibc's
 libraries, libstdc++, libgcc_s). Blender's own TBB (same SONAME libtbb.so.12)
 is reused when Blender has loaded it first; oneTBB keeps that ABI backward
 compatible, so the module built against Debian's 2021.8 runs on Blender's newer
-one (tested by tests/blender/test_extension.py).
+one. Embree 3 and Blender's Embree 4 share C function names: the module reaches
+Embree through dlsym on its own copy (native/core/src/voxel/embree_api.hpp).
+Both tested by tests/package/test_extension.py.
 """
 
 import argparse
@@ -38,6 +40,8 @@ SYSTEM_LIBRARIES = re.compile(
     r"|libstdc\+\+|libgcc_s)\.so"
 )
 LIB_DIR = "lib"
+# Loaded by the module with dlopen, so ldd does not list them: bundled too.
+DLOPENED = ("libembree3.so.3",)  # native/core/src/voxel/embree_api.cpp
 
 MANIFEST = """\
 schema_version = "1.0.0"
@@ -95,6 +99,16 @@ def needed_libraries(path):
     return found
 
 
+def system_library(soname):
+    """Where the dynamic loader finds `soname` (ldconfig's cache)."""
+    out = subprocess.run(["/sbin/ldconfig", "-p"], check=True, capture_output=True, text=True).stdout
+    for line in out.splitlines():
+        match = re.match(r"\s*(\S+)\s+\(([^)]*)\)\s+=>\s+(\S+)", line)
+        if match and match.group(1) == soname and "x86-64" in match.group(2):
+            return match.group(3)
+    raise SystemExit(f"make_package: {soname} is not installed (./exsynth setup installs it)")
+
+
 def patchelf(*args):
     if shutil.which("patchelf") is None:
         raise SystemExit("make_package: patchelf is missing (./exsynth setup installs it)")
@@ -110,6 +124,10 @@ def stage(addon_dir, dest):
         raise SystemExit(f"make_package: expected one compiled _native module in {addon_dir}, found {natives}")
     native = os.path.join(pkg, natives[0])
     libs = needed_libraries(native)
+    for soname in DLOPENED:
+        path = system_library(soname)
+        libs[soname] = path
+        libs.update(needed_libraries(path))
     os.makedirs(os.path.join(pkg, LIB_DIR))
     for soname, resolved in sorted(libs.items()):
         target = os.path.join(pkg, LIB_DIR, soname)

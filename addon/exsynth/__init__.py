@@ -18,12 +18,6 @@ bl_info = {
     "category": "ExSynth",
 }
 
-# A packaged add-on (./exsynth package) binds its module to the libraries it
-# bundles, not to Blender's copies of Embree/OpenVDB (see native_loader.py).
-from . import native_loader as _native_loader  # noqa: E402
-
-_native_loader.load_bundled()
-
 # Registration order matters: the PropertyGroup before anything that reads it.
 _MODULES = ("properties", "operators", "panels", "ui")
 
