@@ -19,7 +19,7 @@ bl_info = {
 }
 
 # Registration order matters: the PropertyGroup before anything that reads it.
-_MODULES = ("properties", "operators", "panels", "overlay")
+_MODULES = ("properties", "operators", "panels", "overlay", "ui")
 
 
 def _modules():
@@ -36,7 +36,8 @@ def register():
     except ImportError as exc:
         raise ImportError(
             "exsynth: the compiled module exsynth._native is missing or does not load "
-            f"({exc}). Build it with `./exsynth build` and enable the add-on from build/addon/."
+            f"({exc}). Build it with `./exsynth build` and enable the add-on from build/addon/, "
+            "or install the zip from `./exsynth package` (Linux x64, Blender with Python 3.11)."
         ) from exc
 
     done, attached = [], []

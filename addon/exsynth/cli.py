@@ -239,9 +239,10 @@ def _parser():
                    "'l' lines) or .npy (N by 3), in the files' coordinates")
     p.add_argument("--resolution", type=_int, default=128,
                    help="voxels along B's longest bounding-box side (default 128)")
-    p.add_argument("--pattern-size", type=_finite, default=0.5,
-                   help="built-in pairs: the pair's cube as a fraction of B's longest side (default 0.5); "
-                   "the pair is made at resolution x pattern size voxels (8..512)")
+    p.add_argument("--pattern-size", type=_finite, default=None,
+                   help="built-in pairs: the pair's cube as a fraction of B's longest side (default: fitted "
+                   "to B's thickness, as the add-on's Fit to Model); the pair is made at resolution x "
+                   "pattern size voxels (8..512)")
     p.add_argument("--out", required=True,
                    help=".obj (B''s isosurface), .vdb (grids sdf and density) or .npy ((Z, Y, X) float32 "
                    "signed distance of B', positive outside)")
@@ -320,7 +321,8 @@ def _run_analogy(args):
     _require(not args.curve or args.field_preset == "along_curve", "--curve goes with --field-preset along_curve")
     _require(any(args.axis), "--axis must not be 0 0 0: give the axis direction, e.g. --axis 0 0 1")
     if args.preset:
-        _require(args.pattern_size > 0, f"--pattern-size must be > 0 (got {args.pattern_size})")
+        _require(args.pattern_size is None or args.pattern_size > 0,
+                 f"--pattern-size must be > 0 (got {args.pattern_size})")
         try:
             analogy_ops.check_settings(args.preset, args.resolution, args.pattern_size, _pair_options(args),
                                        names={"feature_height": "--spike-height", "dilation": "--dilation"})
@@ -338,8 +340,17 @@ def _run_analogy(args):
     b = _analogy_mesh("--b", b_path, field)
     if args.field:
         b.field = _vertex_field(args.field, b.vertices)
+    pattern_scale = args.pattern_size
+    if args.preset and pattern_scale is None:
+        try:
+            pattern_scale, measure = analogy_ops.fitted_pattern_scale(b.vertices, b.triangles, args.resolution)
+        except jobs.InputError as exc:
+            raise UsageError(f"--b: {exc} (--pattern-size)")
+        print(f"exsynth analogy: pattern size {pattern_scale:.3g} of B's longest side, fitted to its "
+              f"thickness {measure['thickness']:.4g}", file=sys.stderr)
     job = analogy_ops.GeometricTextureJob(
-        b=b, preset=args.preset or "spikes", resolution=args.resolution, pattern_scale=args.pattern_size,
+        b=b, preset=args.preset or "spikes", resolution=args.resolution,
+        pattern_scale=0.5 if pattern_scale is None else pattern_scale,
         pair_options=_pair_options(args),
         memory_budget=int(args.memory_budget * GIB), seed=args.seed,
     )

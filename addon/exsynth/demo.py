@@ -12,6 +12,7 @@ import bpy
 import numpy as np
 from mathutils import Vector
 
+from . import compat
 from .io import materials
 from .io import mesh as mesh_io
 from .io.selection import select_only
@@ -175,6 +176,7 @@ def run_analogy(bunny_path, out_dir, resolution=128, pattern_size=0.4, samples=1
     if bpy.ops.exsynth.direction_field() != {'FINISHED'}:
         raise RuntimeError("exsynth.direction_field did not finish")
     settings.geo_resolution = resolution
+    settings.geo_pattern_fit = False  # the demo's figures are made at a set size
     settings.geo_pattern_scale = pattern_size
     made, seconds = {}, {}
     colours = {'SPIKES': (0.72, 0.42, 0.22), 'PITS': (0.45, 0.62, 0.38), 'HOLES': (0.62, 0.52, 0.70),
@@ -275,7 +277,9 @@ def _ensure_addon():
     def raise_error(exc):
         raise exc
 
-    addon_utils.enable("exsynth", default_set=True, handle_error=raise_error)
+    # The add-on's own module name: "exsynth", or "bl_ext.REPO.exsynth" when
+    # installed as an extension.
+    addon_utils.enable(__package__, default_set=True, handle_error=raise_error)
 
 
 def _stage(scene, samples):
@@ -292,8 +296,7 @@ def _stage(scene, samples):
     scene.view_settings.look = 'Medium Contrast'
 
     world = bpy.data.worlds.new("Demo World")
-    world.use_nodes = True
-    background = world.node_tree.nodes["Background"]
+    background = compat.ensure_node_tree(world).nodes["Background"]
     background.inputs["Color"].default_value = (0.30, 0.36, 0.46, 1.0)
     background.inputs["Strength"].default_value = 0.5
     scene.world = world

@@ -6,7 +6,15 @@ from bpy.props import (
     BoolProperty, BoolVectorProperty, EnumProperty, FloatProperty, IntProperty, PointerProperty, StringProperty,
 )
 
+from . import _native
+
 GIB = 1 << 30
+
+# The engine's size rule for solids (the coarsest level holds one
+# neighbourhood): a property's min cannot follow Levels, so the hard min is
+# what one level allows and the soft min what the default 3 levels need; the
+# operator checks the pair (operators/solid.py check_size).
+SOLID_DEFAULT_LEVELS = 3
 
 # The direction-field presets (Direction Field and Geometric Texture).
 FIELD_PRESET_ITEMS = (
@@ -84,14 +92,17 @@ class ExSynthSettings(bpy.types.PropertyGroup):
     )
     solid_size: IntProperty(
         name="Size",
-        description="Voxels along each edge of the solid (it is Size × Size × Size and tiles)",
-        default=64, min=16, max=256,
+        description="Voxels along each edge of the solid (it is Size × Size × Size and tiles); "
+        f"at least {_native.min_texture_size(SOLID_DEFAULT_LEVELS)} with {SOLID_DEFAULT_LEVELS} Levels, "
+        f"{_native.min_texture_size(1)} with 1",
+        default=64, min=_native.min_texture_size(1), soft_min=_native.min_texture_size(SOLID_DEFAULT_LEVELS),
+        max=256,
     )
     solid_levels: IntProperty(
         name="Levels",
         description="Coarse-to-fine levels; the coarsest (Size / 2^(Levels-1)) and the exemplar at "
         "that level must be at least 8 pixels across",
-        default=3, min=1, max=6,
+        default=SOLID_DEFAULT_LEVELS, min=1, max=6,
     )
     solid_iterations: IntProperty(
         name="Iterations",
@@ -280,12 +291,24 @@ class ExSynthSettings(bpy.types.PropertyGroup):
         "with its cube)",
         default=128, min=16, max=512, soft_max=256,
     )
+    geo_pattern_fit: BoolProperty(
+        name="Fit to Model",
+        description="Built-in pairs: size the pattern from the mesh's own thickness (twice the median "
+        "diameter of the balls that fit inside it at its surface), so thin parts get features that "
+        "fit them; the size is shown in the panel and in the viewport. Off: set Pattern Size by hand",
+        default=True,
+    )
     geo_pattern_scale: FloatProperty(
         name="Pattern Size",
-        description="Built-in pairs: how much of the mesh one exemplar cube covers, as a fraction of "
-        "its longest side (smaller: smaller, denser features). The pair is made at Resolution × "
-        "Pattern Size voxels, 8 to 512",
+        description="Built-in pairs, Fit to Model off: how much of the mesh one exemplar cube covers, "
+        "as a fraction of its longest side (smaller: smaller, denser features). The pair is made at "
+        "Resolution × Pattern Size voxels, 8 to 512",
         default=0.5, min=0.05, max=4.0, soft_max=2.0, precision=2,
+    )
+    geo_show_pattern: BoolProperty(
+        name="Show Pattern Size",
+        description="Draw a wire sphere of the pattern's size at the active mesh in the 3D viewport",
+        default=True,
     )
     geo_dilation: FloatProperty(
         name="Dilation",

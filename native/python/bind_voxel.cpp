@@ -3,6 +3,7 @@
 
 #include "arguments.hpp"
 #include "arrays.hpp"
+#include "exsynth/thickness.hpp"
 #include "exsynth/voxelize.hpp"
 
 namespace py = pybind11;
@@ -51,6 +52,52 @@ Returns a dict: density (Z, Y, X) float32 in [0, 1]; sdf (Z, Y, X) float32, mesh
 positive outside (None if compute_sdf=False); origin (3,) float64, the centre of voxel
 [0, 0, 0]; voxel_size. Inside/outside is a 2-of-3 parity vote along the axes, so open
 meshes still give a solid. Releases the GIL; reports to ctx; raises CancelledError.)doc");
+
+  m.def(
+      "model_thickness",
+      [](const ArrayArg& vertices, const ArrayArg& faces, const IntArg& resolution, const RealArg& percentile,
+         const RealArg& pattern_per_thickness, const IntArg& memory_budget, const IntArg& seed,
+         const ContextArg& ctx_arg, const py::kwargs& extra) {
+        reject_unknown(extra, "resolution, percentile, pattern_per_thickness, memory_budget, seed, ctx");
+        TriangleMesh mesh = to_mesh(vertices, faces);
+        ThicknessOptions opt;
+        opt.resolution = int_arg(resolution, "resolution", kMinThicknessResolution, kMaxThicknessResolution,
+                                 "voxels along the longest axis");
+        opt.percentile = real_arg(percentile, "percentile", 0.0, 100.0, Ends::Closed, "of the surface samples");
+        opt.pattern_per_thickness = real_arg(pattern_per_thickness, "pattern_per_thickness", 0.0, 100.0,
+                                             Ends::OpenLow, "pattern size / thickness");
+        opt.memory_budget = memory_budget_arg(memory_budget);
+        opt.seed = seed_arg(seed);
+        ExecContext* ctx = context_arg(ctx_arg);
+        ThicknessResult r;
+        {
+          py::gil_scoped_release release;
+          r = model_thickness(mesh, opt, ctx);
+        }
+        py::dict out;
+        out["thickness"] = r.thickness;
+        out["median"] = r.median;
+        out["low"] = r.low;
+        out["high"] = r.high;
+        out["pattern_size"] = r.pattern_size;
+        out["voxel_size"] = r.voxel_size;
+        out["samples"] = r.samples;
+        return out;
+      },
+      py::arg("vertices"), py::arg("faces"), py::kw_only(), py::arg("resolution") = ThicknessOptions{}.resolution,
+      py::arg("percentile") = ThicknessOptions{}.percentile,
+      py::arg("pattern_per_thickness") = ThicknessOptions{}.pattern_per_thickness, py::arg("memory_budget") = 0,
+      py::arg("seed") = 0,
+      py::arg("ctx") = py::none(),
+      R"doc(How thick a closed mesh is where its surface is.
+
+vertices: V by 3 float32/float64; faces: F by 3 int32/int64. For each surface sample (the
+voxels just inside the surface at `resolution` voxels along the longest side), the diameter
+of the largest ball inside the mesh that touches the surface there; thickness is the
+`percentile` (0..100, default the median) of those over the surface, so thin parts count by
+their area. Returns a dict: thickness, median, low (10th), high (90th percentile), all in mesh
+units; pattern_size (thickness * pattern_per_thickness, default 2: Geometric Texture's default
+pattern size); voxel_size; samples. Releases the GIL; reports to ctx; raises CancelledError.)doc");
 }
 
 }  // namespace exsynth::py_bind

@@ -433,7 +433,7 @@ def test_over_the_memory_budget(bunny):
 
 def test_pair_too_small(bunny):
     run_expecting_error(r"pair would be only 3 voxels.*Raise the resolution or the pattern size",
-                        geo_resolution=32, geo_pattern_scale=0.1)
+                        geo_resolution=32, geo_pattern_fit=False, geo_pattern_scale=0.1)
 
 
 def test_edit_mode(bunny):

@@ -109,7 +109,9 @@ def test_operators_panels_and_settings_are_registered():
     s = settings()
     assert (s.solid_size, s.solid_bake_target, s.solid_bake_resolution) == (64, 'IMAGE', 1024)
     rna = s.bl_rna.properties["solid_size"]
-    assert (rna.hard_min, rna.hard_max) == (16, 256)
+    # The engine's size rule: 1 level allows the hard min, the default levels the soft min.
+    assert (rna.hard_min, rna.hard_max) == (_native.min_texture_size(1), 256)
+    assert rna.soft_min == _native.min_texture_size(s.solid_levels) > rna.hard_min
     assert s.solid_exemplar is None and s.solid_volume is None
 
 
@@ -412,7 +414,18 @@ def test_mesh_without_faces(exemplar):
 
 def test_size_too_small_for_the_levels(cow, exemplar):
     settings().solid_levels = 3  # 16 voxels at the coarsest of 3 levels: 4
-    run_expecting_error(r"size must be between 29 and 2048 voxels with 3 levels.*fewer levels", objects=[cow])
+    started = []
+    jobs.job_started_hooks.append(started.append)
+    run_expecting_error(r"Size 16 is too small for 3 Levels.*at least 29\. Raise Size or use fewer Levels "
+                        r"\(1 level allows Size 8\)", objects=[cow])
+    assert started == []  # refused before the engine starts
+
+
+def test_smallest_size_one_level_allows(cow, exemplar):
+    s = settings()
+    s.solid_levels, s.solid_size = 1, _native.min_texture_size(1)
+    assert s.solid_size == 8  # the property's min lets it through
+    assert run() == {'FINISHED'}
 
 
 def test_over_the_memory_budget(cow, exemplar):

@@ -42,6 +42,10 @@ FUNCTIONS = {
         "resolution": ("int", 1, 16384), "padding": ("int", 0, 1024), "supersample": ("int", 1, 8),
         "voxel_size": ("real", 0, None), "compute_sdf": "bool", "memory_budget": "budget", "seed": "seed",
         "ctx": "ctx"}),
+    "model_thickness": (call("model_thickness", VERTS, FACES, resolution=16), {
+        "resolution": ("int", 16, 1024), "percentile": ("real", 0, 100),
+        "pattern_per_thickness": ("real", 0, 100), "memory_budget": "budget", "seed": "seed",
+        "ctx": "ctx"}),
     "volume_frames": (call("volume_frames", SDF, [0, 0, 0], 1.0, PTS, DIRS), {
         "band": ("real", 0, None), "smoothing_steps": ("int", 0, 1000), "ctx": "ctx"}),
     "synthesize_analogy": (call("synthesize_analogy", SDF, SDF, SDF), {
@@ -209,6 +213,8 @@ def test_set_span_refuses_a_bad_span(lo, hi, words):
 ARRAYS = {
     "voxelize": (lambda **a: _native.voxelize(a.get("vertices", VERTS), a.get("faces", FACES), resolution=8),
                  ["vertices", "faces"]),
+    "model_thickness": (lambda **a: _native.model_thickness(a.get("vertices", VERTS), a.get("faces", FACES),
+                                                            resolution=16), ["vertices", "faces"]),
     "volume_frames": (lambda **a: _native.volume_frames(a.get("sdf", SDF), a.get("origin", [0, 0, 0]), 1.0,
                                                         a.get("points", PTS), a.get("vectors", DIRS)),
                       ["sdf", "origin", "points", "vectors"]),

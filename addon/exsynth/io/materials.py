@@ -7,6 +7,8 @@ have tuned it), a missing one is created and recorded in `created`.
 
 import bpy
 
+from .. import compat
+
 VOLUME_MATERIAL = "ExSynth Volume"
 SURFACE_MATERIAL = "ExSynth Surface"
 
@@ -44,8 +46,7 @@ def new_surface_material(name, rgb, roughness=0.6):
 
 
 def _output_with(mat, shader_type, output_socket):
-    mat.use_nodes = True
-    nodes = mat.node_tree.nodes
+    nodes = compat.ensure_node_tree(mat).nodes
     nodes.clear()
     out = nodes.new("ShaderNodeOutputMaterial")
     out.location = (300, 0)

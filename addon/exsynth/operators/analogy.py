@@ -33,6 +33,7 @@ from . import field as field_ops
 PRESETS = ("spikes", "pits", "holes", "grooves", "dilate")
 FIELD_PRESETS = tuple(field_ops.PRESETS.values())  # around_axis, along_axis, along_curve
 PAIR_MIN, PAIR_MAX = 8, 512  # make_exemplar_pair's resolution range
+PATTERN_SCALE_MIN, PATTERN_SCALE_MAX = 0.05, 4.0  # the panel's Pattern Size range
 MAX_GRID_SIDE = 2048  # voxels along one side of a user pair's grid
 
 # How far A' reaches beyond A in the pair's own units (the pair spans
@@ -50,6 +51,23 @@ def pair_resolution(resolution, pattern_scale):
     that is the pair's resolution. Depends only on the two settings, so it
     is known (and checked) before anything runs."""
     return int(round(pattern_scale * resolution))
+
+
+def fitted_pattern_scale(vertices, triangles, resolution):
+    """Pattern Size fitted to B: the engine's pattern size for B's thickness
+    (_native.model_thickness: twice the median diameter of the balls that
+    fit inside B at its surface) as a fraction of B's longest side, kept in
+    the range a built-in pair allows at `resolution`. Returns (scale, the
+    measure's dict); an InputError when B cannot be measured."""
+    try:
+        measure = _native.model_thickness(vertices, triangles)
+    except _native.InvalidInputError as exc:
+        raise InputError(f"cannot fit the pattern size to the mesh: {exc}. Set the pattern size by hand") from None
+    v = np.asarray(vertices, np.float64)
+    longest = float((v.max(axis=0) - v.min(axis=0)).max())
+    lo = max(PATTERN_SCALE_MIN, PAIR_MIN / resolution)
+    hi = min(PATTERN_SCALE_MAX, PAIR_MAX / resolution)
+    return float(min(max(measure["pattern_size"] / longest, lo), hi)), measure
 
 
 def voxel_size_for(vertices, resolution):
@@ -278,7 +296,7 @@ PANEL_NAMES = {"feature_height": "Spike Height", "dilation": "Dilation"}
 
 def check_settings(preset, resolution, pattern_scale, options=None, names=PANEL_NAMES):
     """For a built-in pair: an InputError naming the setting to change, or
-    None. `options` are the pair's shape options (pair_options()), checked by
+    None. pattern_scale None: fitted to the model (not checked here). `options` are the pair's shape options (pair_options()), checked by
     the engine; `names` maps their engine names to the names the user set
     them by (the panel's labels, the CLI's options)."""
     if preset not in PRESETS:
@@ -290,6 +308,8 @@ def check_settings(preset, resolution, pattern_scale, options=None, names=PANEL_
         for engine_name, user_name in names.items():
             message = message.replace(engine_name, user_name)
         raise InputError(message) from None
+    if pattern_scale is None:
+        return  # fitted to the model: fitted_pattern_scale keeps it in range
     r_pair = pair_resolution(resolution, pattern_scale)
     if r_pair < PAIR_MIN:
         raise InputError(
@@ -490,9 +510,11 @@ class EXSYNTH_OT_geometric_texture(JobOperator, bpy.types.Operator):
         if context.mode != 'OBJECT':
             raise InputError("works in Object Mode only. Press Tab to leave Edit Mode and run it again")
         settings = context.scene.exsynth
-        if settings.geo_pair_source == 'BUILTIN':
-            check_settings(settings.geo_preset.lower(), settings.geo_resolution, settings.geo_pattern_scale,
-                           pair_options(settings))
+        builtin = settings.geo_pair_source == 'BUILTIN'
+        fit = builtin and settings.geo_pattern_fit
+        if builtin:
+            check_settings(settings.geo_preset.lower(), settings.geo_resolution,
+                           None if fit else settings.geo_pattern_scale, pair_options(settings))
         obj = context.active_object
         if obj is None:
             raise InputError(
@@ -500,9 +522,12 @@ class EXSYNTH_OT_geometric_texture(JobOperator, bpy.types.Operator):
                 "Outliner) and run Geometric Texture again"
             )
         b = mesh_input(context, settings, obj, "the active object", "Select a mesh object")
+        scale = settings.geo_pattern_scale
+        if fit:  # the value the panel shows (ui/pattern_preview.py measures the same mesh)
+            scale, _ = fitted_pattern_scale(b.vertices, b.triangles, settings.geo_resolution)
         job = GeometricTextureJob(
             b=b, preset=settings.geo_preset.lower(), resolution=settings.geo_resolution,
-            pattern_scale=settings.geo_pattern_scale, pair_options=pair_options(settings),
+            pattern_scale=scale, pair_options=pair_options(settings),
             memory_budget=settings.memory_budget_bytes, seed=settings.seed,
         )
         if settings.geo_pair_source == 'OBJECTS':

@@ -257,6 +257,16 @@ def world_to_grid(volume_obj, voxel_size):
     return translation(-volume_io.blender_cell_offset(voxel_size)) @ local
 
 
+def check_size(size, levels):
+    """The engine's size rule, refused before any work with the panel's names."""
+    smallest = _native.min_texture_size(levels)
+    if size < smallest:
+        raise InputError(
+            f"Size {size} is too small for {levels} Levels: the coarsest level must hold one "
+            f"neighbourhood, so Size must be at least {smallest}. Raise Size or use fewer Levels "
+            f"(1 level allows Size {_native.min_texture_size(1)})")
+
+
 def check_object_mode(context):
     if context.mode != 'OBJECT':
         raise InputError("works in Object Mode only. Press Tab to leave Edit Mode and run it again")
@@ -324,6 +334,7 @@ class EXSYNTH_OT_solid_texture(JobOperator, bpy.types.Operator):
     def make_job(self, context):
         check_object_mode(context)
         settings = context.scene.exsynth
+        check_size(settings.solid_size, settings.solid_levels)
         exemplar, exemplar_y, exemplar_z, encoding = read_exemplars(
             settings.solid_exemplar, settings.solid_exemplar_y, settings.solid_exemplar_z,
             settings.solid_use_alpha,

@@ -21,7 +21,7 @@ import dataclasses
 import bpy
 import numpy as np
 
-from .. import _native
+from .. import _native, compat
 from ..io import image as image_io
 from ..io.selection import select_only
 from ..jobs import InputError, Job, JobOperator
@@ -196,8 +196,8 @@ def surface_material(name, colour, height, use_alpha, created):
     wired to a Displacement node (bump in EEVEE and Cycles' default
     'Bump Only'), on top of the real displaced geometry."""
     mat = created.add(bpy.data.materials.new(name))
-    mat.use_nodes = True
-    nodes, links = mat.node_tree.nodes, mat.node_tree.links
+    tree = compat.ensure_node_tree(mat)
+    nodes, links = tree.nodes, tree.links
     nodes.clear()
     out = nodes.new("ShaderNodeOutputMaterial")
     bsdf = nodes.new("ShaderNodeBsdfPrincipled")

@@ -5,6 +5,7 @@ import bpy
 
 from ..operators.analogy import PAIR_MAX, PAIR_MIN, pair_resolution
 from ..operators.field import FIELD_ATTRIBUTE
+from ..ui.pattern_preview import length_text, pattern_for
 from .main import SidebarPanel, draw_field_preset, draw_shared_advanced
 
 
@@ -14,6 +15,19 @@ def _is_mesh(obj):
 
 def _has_field(obj):
     return _is_mesh(obj) and obj.data.attributes.get(FIELD_ATTRIBUTE) is not None
+
+
+def _draw_pattern_size(context, layout, pattern):
+    """The pattern's size in scene units (and the thickness it was fitted to)."""
+    if pattern is None:
+        return
+    if "error" in pattern:
+        layout.label(text=f"Pattern: {pattern['error']}", icon='ERROR')
+        return
+    text = f"Pattern {length_text(context, pattern['size'])}"
+    if pattern["thickness"] is not None:
+        text += f" (thickness {length_text(context, pattern['thickness'])})"
+    layout.label(text=text, icon='SPHERE')
 
 
 class EXSYNTH_PT_geometric_texture(SidebarPanel, bpy.types.Panel):
@@ -27,9 +41,14 @@ class EXSYNTH_PT_geometric_texture(SidebarPanel, bpy.types.Panel):
 
         col = layout.column()
         col.prop(settings, "geo_pair_source", expand=True)
+        pattern = pattern_for(context, obj) if builtin else None
         if builtin:
             col.prop(settings, "geo_preset")
-            col.prop(settings, "geo_pattern_scale")
+            col.prop(settings, "geo_pattern_fit")
+            if not settings.geo_pattern_fit:
+                col.prop(settings, "geo_pattern_scale")
+            _draw_pattern_size(context, col, pattern)
+            col.prop(settings, "geo_show_pattern")
             if settings.geo_preset == 'DILATE':
                 col.prop(settings, "geo_dilation")
             elif settings.geo_preset == 'SPIKES':
@@ -55,8 +74,8 @@ class EXSYNTH_PT_geometric_texture(SidebarPanel, bpy.types.Panel):
         else:
             pair = settings.geo_preset.lower() if builtin else getattr(settings.geo_a_prime, "name", "A′")
             box.label(text=f"{obj.name} → {obj.name}_{pair}", icon='MESH_DATA')
-        if builtin:
-            r_pair = pair_resolution(settings.geo_resolution, settings.geo_pattern_scale)
+        if builtin and pattern and "scale" in pattern:
+            r_pair = pair_resolution(settings.geo_resolution, pattern["scale"])
             if not PAIR_MIN <= r_pair <= PAIR_MAX:
                 box.label(text=f"Pair {r_pair}³: needs {PAIR_MIN} to {PAIR_MAX}", icon='ERROR')
             else:

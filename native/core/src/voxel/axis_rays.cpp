@@ -9,6 +9,7 @@
 #include <Eigen/Geometry>
 
 #include "exsynth/errors.hpp"
+#include "voxel/embree_api.hpp"
 
 namespace exsynth::voxel {
 namespace {
@@ -36,18 +37,18 @@ void collect_filter(const RTCFilterFunctionNArguments* args) {
 }  // namespace
 
 AxisRayCaster::AxisRayCaster(const TriangleMesh& mesh) {
-  device_ = rtcNewDevice("verbose=0");
-  if (!device_) throw Error("Embree could not create a device (error " + std::to_string(rtcGetDeviceError(nullptr)) + ")");
-  scene_ = rtcNewScene(device_);
+  device_ = embree().NewDevice("verbose=0");
+  if (!device_) throw Error("Embree could not create a device (error " + std::to_string(embree().GetDeviceError(nullptr)) + ")");
+  scene_ = embree().NewScene(device_);
   // Robust mode makes the ray-triangle test watertight: a ray through a
   // shared edge hits at least one of the two triangles, never neither.
-  rtcSetSceneFlags(scene_, RTC_SCENE_FLAG_ROBUST);
-  rtcSetSceneBuildQuality(scene_, RTC_BUILD_QUALITY_MEDIUM);
+  embree().SetSceneFlags(scene_, RTC_SCENE_FLAG_ROBUST);
+  embree().SetSceneBuildQuality(scene_, RTC_BUILD_QUALITY_MEDIUM);
 
-  RTCGeometry geom = rtcNewGeometry(device_, RTC_GEOMETRY_TYPE_TRIANGLE);
-  auto* vb = static_cast<float*>(rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
+  RTCGeometry geom = embree().NewGeometry(device_, RTC_GEOMETRY_TYPE_TRIANGLE);
+  auto* vb = static_cast<float*>(embree().SetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
                                                          3 * sizeof(float), mesh.vertices.size()));
-  auto* ib = static_cast<unsigned*>(rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
+  auto* ib = static_cast<unsigned*>(embree().SetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
                                                             3 * sizeof(unsigned), mesh.faces.size()));
   Eigen::Vector3f lo = Eigen::Vector3f::Constant(std::numeric_limits<float>::max());
   Eigen::Vector3f hi = -lo;
@@ -63,11 +64,11 @@ AxisRayCaster::AxisRayCaster(const TriangleMesh& mesh) {
     const Eigen::Vector3f n = (mesh.vertices[t[1]] - mesh.vertices[t[0]]).cross(mesh.vertices[t[2]] - mesh.vertices[t[0]]);
     normals_[f] = {n.x(), n.y(), n.z()};
   }
-  rtcSetGeometryIntersectFilterFunction(geom, collect_filter);
-  rtcCommitGeometry(geom);
-  rtcAttachGeometry(scene_, geom);
-  rtcReleaseGeometry(geom);
-  rtcCommitScene(scene_);
+  embree().SetGeometryIntersectFilterFunction(geom, collect_filter);
+  embree().CommitGeometry(geom);
+  embree().AttachGeometry(scene_, geom);
+  embree().ReleaseGeometry(geom);
+  embree().CommitScene(scene_);
 
   const float extent = (hi - lo).maxCoeff();
   for (int k = 0; k < 3; ++k) start_[k] = lo[k] - 1.0f - 0.01f * extent;
@@ -76,8 +77,8 @@ AxisRayCaster::AxisRayCaster(const TriangleMesh& mesh) {
 }
 
 AxisRayCaster::~AxisRayCaster() {
-  if (scene_) rtcReleaseScene(scene_);
-  if (device_) rtcReleaseDevice(device_);
+  if (scene_) embree().ReleaseScene(scene_);
+  if (device_) embree().ReleaseDevice(device_);
 }
 
 void AxisRayCaster::crossings(int axis, float u, float v, std::vector<Crossing>& out) const {
@@ -109,7 +110,7 @@ void AxisRayCaster::crossings(int axis, float u, float v, std::vector<Crossing>&
   rh.ray.flags = 0;
   rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
   rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
-  rtcIntersect1(scene_, &ctx.base, &rh);
+  embree().Intersect1(scene_, &ctx.base, &rh);
 
   std::sort(out.begin(), out.end());
   // Merge same-facing crossings at (nearly) the same position.

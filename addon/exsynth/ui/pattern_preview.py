@@ -1,0 +1,130 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
+"""Geometric Texture's pattern size before running: the value the panel shows
+(in scene units) and a wire sphere of that size drawn at the active mesh.
+
+With Fit to Model on, the size comes from the mesh's thickness
+(operators.analogy.fitted_pattern_scale, the same call the operator makes).
+The measure takes a fraction of a second, so it is kept per mesh state and
+redone only when the mesh, its transform, its modifiers or the resolution
+change; the draw callback reads the same cache.
+"""
+
+import math
+
+import bpy
+import numpy as np
+
+from .. import compat
+from ..io import mesh as mesh_io
+from ..jobs import InputError
+from ..operators import analogy as analogy_ops
+
+COLOR = (1.0, 0.55, 0.1, 0.9)
+SEGMENTS = 64
+_cache = {}
+_handle = None
+
+
+def _state_key(obj, resolution, fit, manual_scale):
+    """What the measure depends on, cheap enough for every redraw: the mesh
+    (its pointer, size and a checksum of its coordinates), the transform,
+    the modifiers and the settings."""
+    mesh = obj.data
+    co = np.empty(len(mesh.vertices) * 3, np.float32)
+    mesh.vertices.foreach_get("co", co)
+    modifiers = tuple((m.type, m.show_viewport) for m in obj.modifiers)
+    matrix = tuple(round(x, 6) for row in obj.matrix_world for x in row)
+    return (obj.name, mesh.as_pointer(), len(co), float(co.sum(dtype=np.float64)), matrix, modifiers,
+            resolution, fit, None if fit else manual_scale)
+
+
+def pattern_for(context, obj):
+    """{'scale', 'size', 'thickness', 'centre'} for `obj` with the scene's
+    settings (size and thickness in world units; thickness None when set by
+    hand), or {'error': message}. None when obj is not a mesh."""
+    if obj is None or obj.type != 'MESH':
+        return None
+    settings = context.scene.exsynth
+    key = _state_key(obj, settings.geo_resolution, settings.geo_pattern_fit, settings.geo_pattern_scale)
+    found = _cache.get(obj.name)
+    if found is not None and found[0] == key:
+        return found[1]
+    # The view layer's graph as it stands: drawing must not re-evaluate it.
+    verts, tris = mesh_io.world_triangles([obj], context.view_layer.depsgraph)
+    if len(tris) == 0:
+        info = {"error": "no faces"}
+    else:
+        lo, hi = verts.min(axis=0), verts.max(axis=0)
+        longest = float((hi - lo).max())
+        info = {"centre": tuple(0.5 * (lo + hi)), "thickness": None}
+        try:
+            if settings.geo_pattern_fit:
+                info["scale"], measure = analogy_ops.fitted_pattern_scale(verts, tris, settings.geo_resolution)
+                info["thickness"] = measure["thickness"]
+            else:
+                info["scale"] = settings.geo_pattern_scale
+            info["size"] = info["scale"] * longest
+        except InputError as exc:
+            info = {"error": str(exc)}
+    _cache.clear()  # one mesh at a time: the active one
+    _cache[obj.name] = (key, info)
+    return info
+
+
+def length_text(context, value):
+    """`value` (world units) as the scene's units show lengths."""
+    units = context.scene.unit_settings
+    if units.system == 'NONE':
+        return f"{value:.3g}"
+    return bpy.utils.units.to_string(units.system, 'LENGTH', value * units.scale_length, precision=3)
+
+
+def sphere_lines(centre, radius, segments=SEGMENTS):
+    """Three great circles (XY, YZ, ZX) as line-segment end points."""
+    a = np.linspace(0.0, 2.0 * math.pi, segments + 1)
+    ring = np.stack([np.cos(a), np.sin(a)], axis=1) * radius
+    lines = []
+    for u, v in ((0, 1), (1, 2), (2, 0)):
+        pts = np.zeros((segments + 1, 3))
+        pts[:, u], pts[:, v] = ring[:, 0], ring[:, 1]
+        pts += np.asarray(centre)
+        lines.append(np.repeat(pts, 2, axis=0)[1:-1])
+    return np.concatenate(lines).astype(np.float32)
+
+
+def _draw():
+    context = bpy.context
+    settings = getattr(context.scene, "exsynth", None)
+    obj = context.active_object
+    if settings is None or not settings.geo_show_pattern or settings.geo_pair_source != 'BUILTIN':
+        return
+    if obj is None or obj.type != 'MESH' or context.mode != 'OBJECT':
+        return
+    info = pattern_for(context, obj)
+    if not info or "error" in info:
+        return
+    import gpu
+    from gpu_extras.batch import batch_for_shader
+
+    shader = compat.builtin_shader('UNIFORM_COLOR')
+    batch = batch_for_shader(shader, 'LINES', {"pos": sphere_lines(info["centre"], 0.5 * info["size"])})
+    gpu.state.blend_set('ALPHA')
+    gpu.state.line_width_set(2.0)
+    shader.uniform_float("color", COLOR)
+    batch.draw(shader)
+    gpu.state.line_width_set(1.0)
+    gpu.state.blend_set('NONE')
+
+
+def attach():
+    global _handle
+    if _handle is None:
+        _handle = bpy.types.SpaceView3D.draw_handler_add(_draw, (), 'WINDOW', 'POST_VIEW')
+
+
+def detach():
+    global _handle
+    if _handle is not None:
+        bpy.types.SpaceView3D.draw_handler_remove(_handle, 'WINDOW')
+        _handle = None
+    _cache.clear()

@@ -1,0 +1,109 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
+"""Geometric Texture's pattern size fitted to the model (Fit to Model, the
+default): the value the panel shows and the viewport draws
+(ui/pattern_preview.py) is the one the operator and the CLI use."""
+
+import re
+
+import bpy
+import numpy as np
+import pytest
+
+from exsynth import _native, cli
+from exsynth.operators import analogy as analogy_ops
+from exsynth.ui import pattern_preview
+from helpers import COW_OBJ, add_faceless_mesh, world_mesh
+
+RESOLUTION = 48
+
+
+def settings():
+    return bpy.context.scene.exsynth
+
+
+def fitted(obj, resolution=RESOLUTION):
+    verts, tris = world_mesh(obj)
+    measure = _native.model_thickness(verts, tris)
+    longest = float((verts.max(0) - verts.min(0)).max())
+    return measure["pattern_size"] / longest, measure, longest
+
+
+def test_fit_to_model_is_the_default_and_thinner_than_the_old_half(cow):
+    s = settings()
+    assert s.geo_pattern_fit and s.geo_show_pattern
+    scale, measure, longest = fitted(cow)
+    info = pattern_preview.pattern_for(bpy.context, cow)
+    assert info["scale"] == pytest.approx(scale) and 0.1 < info["scale"] < 0.5
+    assert info["size"] == pytest.approx(scale * longest)
+    assert info["thickness"] == pytest.approx(measure["thickness"])
+    assert info["size"] == pytest.approx(2 * info["thickness"])  # unless clamped by the pair's range
+
+
+def test_the_operator_uses_the_shown_size(cow, capfd):
+    s = settings()
+    s.geo_resolution = RESOLUTION
+    s.geo_preset = 'SPIKES'
+    shown = pattern_preview.pattern_for(bpy.context, cow)["scale"]
+    assert bpy.ops.exsynth.geometric_texture() == {'FINISHED'}
+    pair = int(re.search(r"pair (\d+)×\1×\1", capfd.readouterr().out).group(1))
+    assert pair == analogy_ops.pair_resolution(RESOLUTION, shown)
+    assert "cow_spikes" in bpy.data.objects
+
+
+def test_set_by_hand(cow):
+    s = settings()
+    s.geo_pattern_fit = False
+    s.geo_pattern_scale = 0.3
+    info = pattern_preview.pattern_for(bpy.context, cow)
+    _, _, longest = fitted(cow)
+    assert info["scale"] == pytest.approx(0.3) and info["thickness"] is None
+    assert info["size"] == pytest.approx(0.3 * longest)
+
+
+def test_follows_the_object_scale(cow):
+    before = pattern_preview.pattern_for(bpy.context, cow)
+    cow.scale = (1.6, 1.6, 1.6)
+    bpy.context.view_layer.update()
+    after = pattern_preview.pattern_for(bpy.context, cow)
+    assert after["scale"] == pytest.approx(before["scale"], rel=0.05)  # a fraction of the longest side
+    assert after["size"] == pytest.approx(2.0 * before["size"], rel=0.05)  # 0.8 -> 1.6
+
+
+def test_fitted_scale_stays_in_the_pairs_range():
+    """A slab 1/50 as thick as it is long would fit a pattern of 4 % of its
+    side: at resolution 48 that is under the pair's 8 voxels, so it is raised."""
+    verts = np.array([[x, y, z] for z in (0, 0.02) for y in (0, 1) for x in (0, 1)], float)
+    quads = [[0, 2, 3, 1], [4, 5, 7, 6], [0, 1, 5, 4], [2, 6, 7, 3], [0, 4, 6, 2], [1, 3, 7, 5]]
+    tris = np.array([[q[0], q[k], q[k + 1]] for q in quads for k in (1, 2)], np.int32)
+    scale, measure = analogy_ops.fitted_pattern_scale(verts, tris, RESOLUTION)
+    assert measure["pattern_size"] < 8 / RESOLUTION
+    assert scale == pytest.approx(8 / RESOLUTION)
+    assert analogy_ops.pair_resolution(RESOLUTION, scale) == analogy_ops.PAIR_MIN
+
+
+def test_mesh_without_faces_shows_why():
+    obj = add_faceless_mesh()
+    bpy.context.view_layer.objects.active = obj
+    assert pattern_preview.pattern_for(bpy.context, obj) == {"error": "no faces"}
+    assert pattern_preview.pattern_for(bpy.context, None) is None
+
+
+def test_sphere_lines_have_the_pattern_size():
+    lines = pattern_preview.sphere_lines((1.0, 2.0, 3.0), 0.25)
+    assert lines.shape == (3 * 2 * pattern_preview.SEGMENTS, 3)
+    assert np.allclose(np.linalg.norm(lines - [1.0, 2.0, 3.0], axis=1), 0.25, atol=1e-6)
+
+
+def test_length_text_in_scene_units():
+    bpy.context.scene.unit_settings.system = 'METRIC'
+    bpy.context.scene.unit_settings.scale_length = 1.0
+    assert pattern_preview.length_text(bpy.context, 0.25).replace(" ", "") in ("25cm", "0.25m")
+
+
+def test_cli_fits_when_no_size_is_given(tmp_path, capsys):
+    out = tmp_path / "cow_spikes.obj"
+    assert cli.main(["analogy", "--b", COW_OBJ, "--preset", "spikes", "--resolution", str(RESOLUTION),
+                     "--out", str(out)]) == 0
+    err = capsys.readouterr().err
+    scale = float(re.search(r"pattern size ([\d.]+) of B's longest side, fitted to its thickness", err).group(1))
+    assert 0.1 < scale < 0.5 and out.exists()
