@@ -175,12 +175,15 @@ def test_texture_sizes_follow_the_engine_rule_by_option_name(tmp_path, monkeypat
     assert os.listdir(tmp_path) == []
 
 
-def huge_exr(path, magnitude=1e20, size=40):
+def huge_exr(path, magnitude=1e20, size=40, nan_at=None):
     """A 32-bit float EXR whose values are ~magnitude (a half-float EXR would
-    hold inf: Blender saves 16-bit unless the scene's settings say 32)."""
+    hold inf: Blender saves 16-bit unless the scene's settings say 32),
+    with a NaN pixel at `nan_at` if given."""
     image = bpy.data.images.new("huge", size, size, float_buffer=True)
     px = np.ones((size, size, 4), np.float32)
     px[..., :3] = np.random.default_rng(1).random((size, size, 3)) * magnitude
+    if nan_at is not None:
+        px[nan_at][0] = np.nan
     image.pixels.foreach_set(px.ravel())
     settings = bpy.context.scene.render.image_settings
     old = settings.file_format, settings.color_depth
@@ -201,3 +204,10 @@ def test_an_exemplar_of_1e20_gives_finite_values_of_its_size(tmp_path, capsys):
     values = np.load(tmp_path / "s.npy")
     assert np.isfinite(values).all()
     assert 1e19 < np.median(values) < 1e20 and np.ptp(values) > 1e19
+
+
+def test_a_nan_pixel_in_the_exemplar_is_named(tmp_path, capsys):
+    exr = huge_exr(tmp_path / "nan.exr", magnitude=1.0, nan_at=(3, 5))
+    code, err = run(capsys, "solid", "--exemplar", exr, "--size", "32", "--out", str(tmp_path / "s.npy"))
+    assert code != 0 and "NaN or infinite pixels" in err and "Traceback" not in err
+    assert not (tmp_path / "s.npy").exists()
