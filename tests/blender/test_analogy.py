@@ -12,6 +12,7 @@ import pytest
 
 from exsynth import _native, cli, jobs
 from exsynth.io import mesh as mesh_io
+from exsynth.operators import field_paint_session
 from helpers import BUNNY_OBJ, add_camera, add_faceless_mesh, enclosed_volume, read_obj, scene_state, world_mesh
 
 RESOLUTION = 48  # quick runs; the measured properties use 64
@@ -109,14 +110,29 @@ def test_spikes_from_the_field_preset_add_surface(bunny, capfd):
     assert surface_area(r_verts, r_tris) > 1.12 * surface_area(*own)
 
 
-@pytest.mark.parametrize("source", ["preset around Z", "attribute along Z", "curve around Z"])
+def paint_upward(obj):
+    """Paint Direction Field as the tool does it (PaintSession): one stroke
+    sample pointing up world Z at every 40th vertex, brush a tenth of the
+    model's size, then the diffusion on release; leaves `exsynth_field`."""
+    verts, _ = world_mesh(obj)
+    radius = 0.1 * float((verts.max(0) - verts.min(0)).max())
+    session = field_paint_session.PaintSession(obj, "exsynth_paint")
+    session.begin_stroke()
+    for centre in verts[::40]:
+        session.apply(centre, (0.0, 0.0, 1.0), radius)
+    session.end_stroke()
+    session.finish()
+
+
+@pytest.mark.parametrize("source", ["preset around Z", "attribute along Z", "curve around Z", "painted up Z"])
 def test_grooves_follow_the_field(bunny, source):
     # The grooves pair's grooves run along its field. With the field around
     # world Z (the panel's default preset) the bunny gets horizontal rings;
     # an `exsynth_field` along Z on the mesh wins over that preset and turns
     # them vertical; a horizontal circle (a curve object, moved and scaled)
-    # around the bunny gives rings again. Measured ratios at 64 voxels:
-    # 1.94, 0.63 and 1.94.
+    # around the bunny gives rings again; a field painted upward (Paint
+    # Direction Field's strokes, diffused) turns them vertical too. Measured
+    # ratios at 64 voxels: 2.25, 0.64, 2.20 and 0.64.
     verts, tris = world_mesh(bunny)
     settings = dict(geo_field_preset='AROUND_AXIS', geo_field_axis='Z')
     if source == "attribute along Z":
@@ -129,9 +145,11 @@ def test_grooves_follow_the_field(bunny, source):
         bpy.context.view_layer.objects.active = bunny
         bpy.context.view_layer.update()
         settings = dict(geo_field_preset='ALONG_CURVE', geo_field_curve=circle)
+    elif source == "painted up Z":  # painted in the viewport, then used as it is
+        paint_upward(bunny)
     assert texture("GROOVES", resolution=64, geo_make_volume=True, **settings) == {'FINISHED'}
     ratio = groove_ratio(verts, tris, *b_prime_grid("bunny_grooves_volume"))
-    if source == "attribute along Z":
+    if source in ("attribute along Z", "painted up Z"):
         assert ratio < 0.9
     else:
         assert ratio > 1.5
