@@ -19,7 +19,7 @@ bl_info = {
 }
 
 # Registration order matters: the PropertyGroup before anything that reads it.
-_MODULES = ("properties", "operators", "panels", "overlay", "ui")
+_MODULES = ("properties", "operators", "panels", "overlay", "ui", "keymap")
 
 
 def _modules():

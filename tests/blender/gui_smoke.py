@@ -342,6 +342,12 @@ def paint_overlay():
     check(abs(before) < 0.2 and n > 10, f"before painting the field crosses the stroke (mean dot {before:.2f})")
     state["field_before"] = _field().copy()
     _in_viewport(lambda: bpy.ops.ed.undo_push(message="before painting"))
+    from exsynth import keymap
+
+    items = [k for k in bpy.context.window_manager.keyconfigs.addon.keymaps["3D View"].keymap_items
+             if k.idname == "exsynth.paint_direction_field"]
+    check(len(items) == 1 and (items[0].type, items[0].shift, items[0].alt) == ('P', True, True)
+          and keymap.PAINT_SHORTCUT["type"] == 'P', "Shift+Alt+P in the 3D viewport starts Paint Direction Field")
     check(invoke_in_viewport("paint_direction_field") == {'RUNNING_MODAL'}, "Paint Direction Field runs modal")
     win, area, region = _viewport()
     cx, cy = region.x + region.width // 2, region.y + region.height // 2

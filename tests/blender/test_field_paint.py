@@ -297,3 +297,25 @@ def test_strokes_start_only_over_the_open_viewport_not_its_sidebar():
     assert at(400, 630) is None  # over the header
     assert at(50, 300) is None  # outside the area
     assert field_paint._view_region(NS(area=None), NS(mouse_x=400, mouse_y=300)) is None
+
+
+def _paint_shortcuts():
+    keymap = bpy.context.window_manager.keyconfigs.addon.keymaps.get("3D View")
+    return [k for k in keymap.keymap_items if k.idname == "exsynth.paint_direction_field"] if keymap else []
+
+
+def test_shift_alt_p_starts_the_paint_tool_and_clashes_with_nothing():
+    import exsynth
+
+    (item,) = _paint_shortcuts()
+    assert (item.type, item.value, item.shift, item.alt, item.ctrl) == ('P', 'PRESS', True, True, False)
+    default = bpy.context.window_manager.keyconfigs.default
+    clashes = [(km.name, k.idname) for km in default.keymaps for k in km.keymap_items
+               if k.active and (k.type, k.shift, k.alt, k.ctrl, k.oskey) == ('P', True, True, False, False)]
+    assert clashes == []
+    exsynth.unregister()
+    try:
+        assert _paint_shortcuts() == []  # disabling the add-on takes its shortcut away
+    finally:
+        exsynth.register()
+    assert len(_paint_shortcuts()) == 1
