@@ -38,6 +38,22 @@ class InputError(ValueError):
     """The scene is not a valid input; the message says what to select or change."""
 
 
+def active_mesh(obj, task, again, editable=False):
+    """`obj` (the active object) when it is a mesh, else an InputError in the
+    user's words: `task` names what to select ("the mesh to voxelize"),
+    `again` how to retry ("run Voxelize again"). `editable`: the job writes
+    an attribute onto it, so a mesh linked from another file is refused."""
+    if obj is None:
+        raise InputError(f"no active object. Select {task} (click it in the viewport or the Outliner) and {again}")
+    if obj.type != 'MESH':
+        raise InputError(f"the active object '{obj.name}' is a {obj.type.lower()}, not a mesh. "
+                         f"Select a mesh object and {again}")
+    if editable and (obj.library is not None or obj.data.library is not None):
+        raise InputError(f"the mesh '{obj.name}' is linked from another file, so it cannot get an attribute. "
+                         "Make it local (Object > Relations > Make Local)")
+    return obj
+
+
 class Job:
     """Plain data plus ``run(ctx) -> result``, executed off the main thread."""
 

@@ -17,7 +17,7 @@ import numpy as np
 
 from .. import _native
 from ..io import mesh as mesh_io
-from ..jobs import InputError, Job, JobOperator
+from ..jobs import InputError, Job, JobOperator, active_mesh
 
 FIELD_ATTRIBUTE = "exsynth_field"
 PAINT_ATTRIBUTE = "exsynth_paint"
@@ -127,21 +127,7 @@ def curve_points(curve_obj, mesh_obj, depsgraph):
 
 def field_job(context, obj, settings):
     """The FieldJob for `obj` and the panel's settings (raises InputError)."""
-    if obj is None:
-        raise InputError(
-            "no active object. Select the mesh to give a direction field (click it in the "
-            "viewport or the Outliner) and run Direction Field again"
-        )
-    if obj.type != 'MESH':
-        raise InputError(
-            f"the active object '{obj.name}' is a {obj.type.lower()}, not a mesh. "
-            "Select a mesh object and run Direction Field again"
-        )
-    if obj.library is not None or obj.data.library is not None:
-        raise InputError(
-            f"the mesh '{obj.name}' is linked from another file, so it cannot get an attribute. "
-            "Make it local (Object > Relations > Make Local)"
-        )
+    active_mesh(obj, "the mesh to give a direction field", "run Direction Field again", editable=True)
     verts, tris = mesh_io.mesh_arrays(obj.data)
     if len(tris) == 0:
         raise InputError(

@@ -13,7 +13,7 @@ import numpy as np
 
 from .. import _native, field_brush
 from ..io import mesh as mesh_io
-from ..jobs import InputError
+from ..jobs import InputError, active_mesh
 from .field import FIELD_ATTRIBUTE, check_field_slot, read_vectors
 
 UNDO_DEPTH = 64  # strokes Ctrl+Z can take back inside one session
@@ -28,21 +28,7 @@ LIVE_DIFFUSION_LIMIT = 50000
 
 def check_target(obj, paint_name):
     """The mesh to paint on, or an InputError saying what to change."""
-    if obj is None:
-        raise InputError(
-            "no active object. Select the mesh to paint a direction field on (click it in the viewport "
-            "or the Outliner) and start Paint Direction Field again"
-        )
-    if obj.type != 'MESH':
-        raise InputError(
-            f"the active object '{obj.name}' is a {obj.type.lower()}, not a mesh. Select a mesh object "
-            "and start Paint Direction Field again"
-        )
-    if obj.library is not None or obj.data.library is not None:
-        raise InputError(
-            f"the mesh '{obj.name}' is linked from another file, so it cannot get an attribute. "
-            "Make it local (Object > Relations > Make Local)"
-        )
+    active_mesh(obj, "the mesh to paint a direction field on", "start Paint Direction Field again", editable=True)
     if len(obj.data.polygons) == 0:
         raise InputError(
             f"the mesh '{obj.name}' has no faces (only vertices or edges), so there is no surface to paint "

@@ -11,7 +11,7 @@ from .. import _native
 from ..io import mesh as mesh_io
 from ..io import volume as volume_io
 from ..io.selection import select_only
-from ..jobs import InputError, Job, JobOperator
+from ..jobs import InputError, Job, JobOperator, active_mesh
 
 
 @dataclasses.dataclass
@@ -74,16 +74,7 @@ class VoxelizeJob(Job):
 
 def source_triangles(obj, depsgraph):
     """World-space triangles of `obj`, or an InputError saying what to select."""
-    if obj is None:
-        raise InputError(
-            "no active object. Select the mesh to voxelize (click it in the viewport or the "
-            "Outliner) and run Voxelize again"
-        )
-    if obj.type != 'MESH':
-        raise InputError(
-            f"the active object '{obj.name}' is a {obj.type.lower()}, not a mesh. "
-            "Select a mesh object and run Voxelize again"
-        )
+    active_mesh(obj, "the mesh to voxelize", "run Voxelize again")
     verts, tris = mesh_io.world_triangles([obj], depsgraph)
     if len(tris) == 0:
         raise InputError(
