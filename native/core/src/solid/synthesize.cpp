@@ -307,9 +307,12 @@ TextureResult optimize_texture(const Job& job, const TextureOptimizationOptions&
     if (!coarsest) solver->inherit_matches(*previous);
 
     const int iterations = coarsest ? 2 * opt.iterations : opt.iterations;
+    const bool finest = l == L - 1;
+    const bool exemplar_values = finest && opt.exemplar_values;
     StageProgress progress(ctx, stage, p0 + 0.1 * (p1 - p0), p1,
                            std::size_t(iterations) * (solver->search_units() + solver->optimize_units()) +
-                               (!coarsest && opt.coherent_upsampling ? solver->optimize_units() : 0));
+                               (!coarsest && opt.coherent_upsampling ? solver->optimize_units() : 0) +
+                               (exemplar_values ? solver->discrete_units() : 0));
     // Coherent upsampling: the finer level's texture is first rebuilt from the
     // inherited matches, i.e. from the finer exemplar's own texels, instead of
     // being searched from the trilinearly upsampled (blurred) coarse texture:
@@ -329,6 +332,13 @@ TextureResult optimize_texture(const Job& job, const TextureOptimizationOptions&
       result.energy_level.push_back(l);
       if (ctx) ctx->set_stage(stage + " optimise");
       solver->optimize(it, progress);
+    }
+    // Exemplar values (docs/solid.md, "Where the detail went"): the weighted
+    // mean of disagreeing windows is what blurs; the output takes the texels
+    // of the best-matching windows instead.
+    if (exemplar_values) {
+      if (ctx) ctx->set_stage(stage + " exemplar values");
+      solver->discrete(progress, &result.source);
     }
     previous = std::move(solver);
     prev_index = std::move(index);  // the solver's views point into these
