@@ -413,6 +413,7 @@ void LevelSolver::discrete(StageProgress& progress, std::vector<std::int32_t>* s
   if (source) source->assign(tex_.voxel_count(), -1);
   // Rows of voxels (y, z) in parallel: an image is a single z-slice.
   parallel_chunks(std::size_t(dims[1]) * dims[2], 1, progress, [&](std::size_t r0, std::size_t r1) {
+    std::vector<int> du_list(n_), dv_list(n_), su_list(n_), sv_list(n_);
     for (std::size_t row = r0; row < r1; ++row) {
       const int y = int(row % std::size_t(dims[1])), z = int(row / std::size_t(dims[1]));
       for (int x = 0; x < dims[0]; ++x) {
@@ -427,20 +428,25 @@ void LevelSolver::discrete(StageProgress& progress, std::vector<std::int32_t>* s
           const int width = w.ex->image().width();
           float best_weight = -1.0f, support = 0.0f;
           std::size_t pix = 0;
-          // Windows covering p: sparse voxels at p - (d - lo) per slice axis.
-          for (int dv = 0; dv < n_; ++dv) {
-            const int sv = wrapped[s.v][p[s.v] - dv + lo_ + n_];
-            if (sv < 0 || (sv & 1)) continue;
-            for (int du = 0; du < n_; ++du) {
-              const int su = wrapped[s.u][p[s.u] - du + lo_ + n_];
-              if (su < 0 || (su & 1)) continue;
-              const std::size_t sp = (std::size_t(p[s.axis]) * w.nv + sv / 2) * w.nu + su / 2;
+          // Windows covering p: sparse voxels at p - (d - lo) (even) per slice axis.
+          int nu = 0, nv = 0;
+          for (int d = 0; d < n_; ++d) {
+            const int su = wrapped[s.u][p[s.u] - d + lo_ + n_];
+            if (su >= 0 && !(su & 1)) du_list[nu] = d, su_list[nu++] = su / 2;
+            const int sv = wrapped[s.v][p[s.v] - d + lo_ + n_];
+            if (sv >= 0 && !(sv & 1)) dv_list[nv] = d, sv_list[nv++] = sv / 2;
+          }
+          for (int a = 0; a < nv; ++a) {
+            const std::size_t row_sp = (std::size_t(p[s.axis]) * w.nv + sv_list[a]) * w.nu;
+            for (int b = 0; b < nu; ++b) {
+              const std::size_t sp = row_sp + su_list[b];
               const int j = w.match[sp];
               if (j < 0) continue;
-              support += w.weight[sp];
-              if (w.weight[sp] <= best_weight) continue;  // ties: the first in scan order
-              best_weight = w.weight[sp];
-              pix = std::size_t(w.ex->centre_v(j) - lo_ + dv) * width + (w.ex->centre_u(j) - lo_ + du);
+              const float wt = w.weight[sp];
+              support += wt;
+              if (wt <= best_weight) continue;  // ties: the first in scan order
+              best_weight = wt;
+              pix = std::size_t(w.ex->centre_v(j) - lo_ + dv_list[a]) * width + (w.ex->centre_u(j) - lo_ + du_list[b]);
             }
           }
           if (best_weight >= 0.0f && support > best_support) best_support = support, best_view = i, best_pix = pix;
