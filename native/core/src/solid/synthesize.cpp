@@ -207,12 +207,14 @@ TextureResult optimize_texture(const Job& job, const TextureOptimizationOptions&
   }
 
   // Peak memory: the finest texture twice (upsampling), the sparse matches,
-  // weights and energies (double-buffered), the constraint pyramid and the
-  // exemplar analysis (neighbourhoods, coefficients, k-NN lists per thread).
+  // weights and energies (double-buffered), the exemplar-values sources, the
+  // constraint pyramid and the exemplar analysis (neighbourhoods,
+  // coefficients, k-NN lists per thread).
   // Each part's advice names its own cause.
   {
     const double voxels = double(job.finest.voxels());
     double texture_bytes = voxels * channels * 4.0 * 2.0 + voxels * 3.0 / 4.0 * 16.0;
+    if (opt.exemplar_values) texture_bytes += voxels * 4.0;  // TextureResult::source
     if (constraint_in && !constraint_in->empty()) texture_bytes += voxels * (channels + 1) * 4.0 * 8.0 / 7.0;
     double exemplar_bytes = 0;
     const Image* largest = images[0];
