@@ -66,6 +66,7 @@ void set_common(TextureOptimizationOptions& o, const py::kwargs& kw) {
     else if (k == "histogram_bins") o.histogram_bins = int_arg(v, k, 2, 256);
     else if (k == "mean_shift") o.mean_shift = bool_arg(v, k);
     else if (k == "coherent_upsampling") o.coherent_upsampling = bool_arg(v, k);
+    else if (k == "exemplar_values") o.exemplar_values = bool_arg(v, k);
     else if (k == "feature_weight") o.feature_weight = real_arg(v, k, 0.0, 100.0, Ends::Closed, "0 = off");
     else if (k == "tileable") o.tileable = bool_arg(v, k);
     else if (k == "max_exemplar_size") o.max_exemplar_size = int_arg(v, k, 0, 1 << 16);
@@ -75,6 +76,7 @@ void set_common(TextureOptimizationOptions& o, const py::kwargs& kw) {
       throw InvalidInput("unknown option '" + k +
                          "'; options: levels, neighborhood, iterations, r, pca_variance, max_pca_dims, search, "
                          "coherence_k, random_candidates, ann_eps, histogram_matching, histogram_bins, mean_shift, coherent_upsampling, "
+                         "exemplar_values, "
                          "feature_weight, tileable, max_exemplar_size, memory_budget, seed");
   }
 }
@@ -160,7 +162,7 @@ views: active slices, 'xyz' or two of them. constraint: (size, size, size, C + 1
 target values then a weight in [0, 1]. Options (keywords): levels=3, neighborhood=8,
 iterations=3, r=0.8, pca_variance=0.95, max_pca_dims=32, search='kcoherence'|'kdtree'|'exact',
 coherence_k=4, random_candidates=2, ann_eps=2.0, histogram_matching=True, histogram_bins=16,
-mean_shift=False, coherent_upsampling=True, feature_weight=0 (> 0: feature-distance channel), tileable=True,
+mean_shift=False, coherent_upsampling=True, exemplar_values=True, feature_weight=0 (> 0: feature-distance channel), tileable=True,
 max_exemplar_size=256 (working resolution: larger exemplars are halved until they fit; 0 = never),
 memory_budget=0 (default), seed=0. size: min_texture_size(levels, neighborhood) .. SOLID_MAX_SIZE.
 Returns {'solid': (Z, Y, X, C) float32, 'energy': [...], 'energy_level': [...]}.)doc");

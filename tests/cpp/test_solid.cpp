@@ -11,6 +11,7 @@
 #include <limits>
 
 #include "exsynth/solid.hpp"
+#include "support/cancel.hpp"
 #include "support/textures.hpp"
 
 using namespace exsynth;
@@ -481,4 +482,74 @@ TEST(Solid, FeatureChannelGuidesMatchingAndIsDropped) {
   SolidExemplars constrained = one_exemplar(ex);
   constrained.constraint = Volume(o.size, o.size, o.size, 4);
   EXPECT_THROW(synthesize_solid(constrained, o), InvalidInput);
+}
+
+// Exemplar values (the final discrete pass): every output value is an
+// exemplar texel, exactly the one the reported source names, and the
+// discrete output resembles the exemplar at least as well as the average.
+TEST(Solid, ExemplarValuesAreTheExemplarsTexelsAtTheirSource) {
+  const Image ex = disc_texture(32, 32, 3, 21);
+  const TextureResult r = synthesize_solid(one_exemplar(ex), small_options());
+  ASSERT_EQ(r.source.size(), r.texture.voxel_count());
+  for (std::size_t v = 0; v < r.texture.voxel_count(); ++v) {
+    ASSERT_GE(r.source[v], 0) << "voxel " << v << " was not covered by any window";
+    const std::size_t pix = std::size_t(r.source[v]) & ((std::size_t(1) << 28) - 1);
+    ASSERT_LT(pix, ex.pixel_count());
+    ASSERT_LT(r.source[v] >> 28, 3);
+    for (int c = 0; c < 3; ++c) ASSERT_EQ(r.texture.values()[v * 3 + c], ex.data()[pix * 3 + c]) << "voxel " << v;
+  }
+  // All three views contribute (the choice is not stuck on one view).
+  std::array<int, 3> per_view{};
+  for (std::int32_t s : r.source) ++per_view[s >> 28];
+  for (int i = 0; i < 3; ++i) EXPECT_GT(per_view[i], int(r.source.size() / 10)) << "view " << i;
+
+  SolidOptions averaged = small_options();
+  averaged.exemplar_values = false;
+  const TextureResult a = synthesize_solid(one_exemplar(ex), averaged);
+  EXPECT_TRUE(a.source.empty());
+  for (int axis = 0; axis < 3; ++axis)
+    EXPECT_LT(slice_to_exemplar_distance(r.texture, axis, ex), 1.25 * slice_to_exemplar_distance(a.texture, axis, ex));
+}
+
+TEST(Image2D, ExemplarValuesComeFromTheExemplarAndAreDeterministic) {
+  const Image ex = disc_texture(32, 32, 3, 22);
+  ImageSynthesisOptions o;
+  o.width = 40;
+  o.height = 36;
+  o.levels = 2;
+  o.seed = 3;
+  Image one, eight;
+  {
+    tbb::global_control limit(tbb::global_control::max_allowed_parallelism, 1);
+    one = synthesize_image(ex, o);
+  }
+  {
+    tbb::global_control limit(tbb::global_control::max_allowed_parallelism, 8);
+    eight = synthesize_image(ex, o);
+  }
+  EXPECT_EQ(one.values(), eight.values());
+  // The exemplar's value set, exactly (brute force over its pixels).
+  for (std::size_t p = 0; p < one.pixel_count(); ++p) {
+    bool found = false;
+    for (std::size_t q = 0; q < ex.pixel_count() && !found; ++q)
+      found = one.data()[p * 3] == ex.data()[q * 3] && one.data()[p * 3 + 1] == ex.data()[q * 3 + 1] &&
+              one.data()[p * 3 + 2] == ex.data()[q * 3 + 2];
+    ASSERT_TRUE(found) << "pixel " << p << " is not an exemplar texel";
+  }
+}
+
+TEST(Solid, CancelInsideTheExemplarValuesPass) {
+  const Image ex = disc_texture(32, 32, 3, 23);
+  const SolidOptions o = small_options();
+  const auto outcome = exsynth::testing::cancel_in_stage(
+      [&](ExecContext* ctx) { synthesize_solid(one_exemplar(ex), o, ctx); }, "solid: level 2/2 exemplar values");
+  EXPECT_TRUE(outcome.threw_cancelled);
+  EXPECT_EQ(outcome.stage_at_throw, "solid: level 2/2 exemplar values");
+  ImageSynthesisOptions io;
+  io.width = io.height = 48;
+  io.levels = 2;
+  const auto image = exsynth::testing::cancel_in_stage(
+      [&](ExecContext* ctx) { synthesize_image(ex, io, ctx); }, "image: level 2/2 exemplar values");
+  EXPECT_TRUE(image.threw_cancelled);
+  EXPECT_EQ(image.stage_at_throw, "image: level 2/2 exemplar values");
 }

@@ -68,10 +68,10 @@ FUNCTIONS = {
         "max_pca_dims": ("int", 1, 4096), "search": "str", "coherence_k": ("int", 0, 64),
         "random_candidates": ("int", 0, 64), "ann_eps": ("real", 0, 1e6), "histogram_matching": "bool",
         "histogram_bins": ("int", 2, 256), "mean_shift": "bool", "feature_weight": ("real", 0, 100),
-        "tileable": "bool", "memory_budget": "budget", "seed": "seed", "ctx": "ctx"}),
+        "exemplar_values": "bool", "tileable": "bool", "memory_budget": "budget", "seed": "seed", "ctx": "ctx"}),
     "synthesize_image": (call("synthesize_image", IMG, width=8, height=8, levels=1, iterations=1), {
         "width": ("int", 1, 16384), "height": ("int", 1, 16384), "levels": ("int", 1, 8), "r": ("real", 0, 2),
-        "memory_budget": "budget", "seed": "seed", "tileable": "bool", "ctx": "ctx"}),
+        "exemplar_values": "bool", "memory_budget": "budget", "seed": "seed", "tileable": "bool", "ctx": "ctx"}),
     "diffuse_direction_field": (call("diffuse_direction_field", VERTS, FACES, GIVEN), {
         "weights": "str", "seed": "seed", "ctx": "ctx"}),
     "preset_direction_field": (call("preset_direction_field", VERTS, FACES), {"preset": "str", "ctx": "ctx"}),

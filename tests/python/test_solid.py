@@ -293,14 +293,44 @@ def test_image_is_as_crisp_as_its_exemplar(name):
 
 @pytest.mark.parametrize("name, sharp, contrast", [("crackedground.png", 0.5, 0.65), ("drkwood2.png", 0.5, 0.5)])
 def test_solid_keeps_a_floor_of_sharpness_and_contrast(name, sharp, contrast):
-    # Measured (32^3, 2 levels, seed 7): crackedground 0.61 / 0.75, drkwood2
-    # 0.61 / 0.63. Solids stay softer than images (docs/solid.md); the floor
-    # catches a blur regression such as per-level trilinear smoothing.
+    # Measured (32^3, 2 levels, seed 7), sharpness / contrast / nn_rel,
+    # averaged -> exemplar values: crackedground 0.61 / 0.75 / 0.60 ->
+    # 0.87 / 0.90 / 0.72, drkwood2 0.61 / 0.63 / 0.37 -> 0.87 / 0.65 / 0.44. Solids stay
+    # softer than images (docs/solid.md); the floor catches a blur regression
+    # such as per-level trilinear smoothing, and exemplar values must add
+    # sharpness over the averaged result without losing the structure.
     ex = exemplar(name, size=64)
     E = quality.Exemplar(ex)
     s = _native.synthesize_solid(ex, size=32, levels=2, seed=7)["solid"]
     m = quality.volume_metrics(E, s, slices=4)["mean"]
     assert m["sharpness"] >= sharp and m["contrast"] >= contrast, m
+    a = _native.synthesize_solid(ex, size=32, levels=2, seed=7, exemplar_values=False)["solid"]
+    ma = quality.volume_metrics(E, a, slices=4)["mean"]
+    assert m["sharpness"] >= ma["sharpness"] + 0.05, (m, ma)
+    assert m["nn_rel"] <= ma["nn_rel"] + 0.15, (m, ma)
+
+
+@pytest.mark.parametrize("what", ["solid", "image"])
+def test_exemplar_values_are_the_exemplars_texels(what):
+    # The final pass takes exemplar texels: every output colour is one of the
+    # exemplar's (uint8 scaled to [0, 1]: within float rounding of k / 255,
+    # and that k triple is an exemplar pixel); off, the averages are not.
+    ex = exemplar("crackedground.png", size=40)
+    palette = {tuple(p) for p in ex.reshape(-1, 3).tolist()}
+
+    def not_texels(values):
+        k = np.rint(values * 255.0)
+        off_grid = np.abs(values * 255.0 - k).max(1) > 1e-3
+        return int(sum(o or tuple(t) not in palette for o, t in zip(off_grid, k.astype(int).tolist())))
+
+    def run(**kw):
+        if what == "solid":
+            return _native.synthesize_solid(ex, size=29, seed=3, **kw)["solid"].reshape(-1, 3)
+        return _native.synthesize_image(ex, width=48, height=40, seed=3, **kw)["image"].reshape(-1, 3)
+    out = run()
+    assert not_texels(out) == 0, f"{not_texels(out)} of {len(out)} values are not exemplar texels"
+    averaged = run(exemplar_values=False)
+    assert not_texels(averaged) > len(averaged) // 2
 
 
 def test_quality_metrics_on_known_cases():

@@ -59,6 +59,11 @@ struct TextureOptimizationOptions {
   /// from the trilinearly upsampled texture alone, which keeps the detail.
   bool coherent_upsampling = true;
   bool mean_shift = false;       ///< mean-shift mode of the contributions instead of the mean (sharper)
+  /// Final pass at the finest level: every voxel (pixel) takes the exemplar
+  /// texel its best-matching window puts there instead of the optimisation's
+  /// weighted mean, so the output's values are the exemplar's (crisp; see
+  /// docs/solid.md). Off = the paper's averaged result.
+  bool exemplar_values = true;
   /// > 0: add the feature-distance channel (signed distance to the edges of
   /// the exemplar's dark features) with this weight relative to colours in
   /// [0, 1]; it guides matching and is dropped from the output. 0 = off.
@@ -94,6 +99,10 @@ struct TextureResult {
   Volume texture;                      ///< the solid (size^3 x C), or the image as a (W, H, 1) volume
   std::vector<double> energy;          ///< mean energy per match after each search, all levels in order
   std::vector<int> energy_level;       ///< level of each energy entry (0 = coarsest)
+  /// With exemplar_values: per voxel (x fastest) the exemplar texel taken,
+  /// view * 2^28 + pixel index (row * width + column) in that view's working
+  /// exemplar; -1 where the optimised value was kept. Empty otherwise.
+  std::vector<std::int32_t> source;
 };
 
 TextureResult synthesize_solid(const SolidExemplars& exemplars, const SolidOptions& opt = {},

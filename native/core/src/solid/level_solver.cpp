@@ -389,3 +389,80 @@ void LevelSolver::optimize(int iteration, StageProgress& progress) {
 }
 
 }  // namespace exsynth::solid
+
+namespace exsynth::solid {
+
+// Exemplar values. The optimisation's value is an IRLS-weighted mean of up to
+// 3 x (n/2)^2 exemplar texels from windows that disagree (most of all across
+// the three orthogonal views), and that mean is what blurs (docs/solid.md,
+// per-stage figures). This pass gives every voxel one exemplar texel instead:
+// the one the best-matching window covering it (the highest IRLS weight over
+// all views) puts there. Neighbouring voxels share windows, so the result is
+// made of coherent pieces of exemplar, i.e. a map of exemplar coordinates.
+// Measured alternatives (the views' best texels, then the one nearest the mean
+// or their medoid) kept less detail. Reads only the matches: each voxel's
+// choice is independent of the others, so any thread count gives the same.
+void LevelSolver::discrete(StageProgress& progress, std::vector<std::int32_t>* source) {
+  const int dims[3] = {tex_.nx(), tex_.ny(), tex_.nz()};
+  std::array<std::vector<int>, 3> wrapped;  // as in optimize(): -1 = outside (not tileable)
+  for (int a = 0; a < 3; ++a) {
+    wrapped[a].resize(std::size_t(dims[a]) + 2 * n_);
+    for (int x = -n_; x < dims[a] + n_; ++x)
+      wrapped[a][x + n_] = wrap_ ? ((x % dims[a]) + dims[a]) % dims[a] : (x < 0 || x >= dims[a] ? -1 : x);
+  }
+  if (source) source->assign(tex_.voxel_count(), -1);
+  // Rows of voxels (y, z) in parallel: an image is a single z-slice.
+  parallel_chunks(std::size_t(dims[1]) * dims[2], 1, progress, [&](std::size_t r0, std::size_t r1) {
+    std::vector<int> du_list(n_), dv_list(n_), su_list(n_), sv_list(n_);
+    for (std::size_t row = r0; row < r1; ++row) {
+      const int y = int(row % std::size_t(dims[1])), z = int(row / std::size_t(dims[1]));
+      for (int x = 0; x < dims[0]; ++x) {
+        const int p[3] = {x, y, z};
+        int best_view = -1;
+        std::size_t best_pix = 0;
+        float best_support = -1.0f;
+        for (int i = 0; i < 3; ++i) {
+          const View& w = views_[i];
+          if (!w.ex) continue;
+          const SliceAxes& s = kSlices[i];
+          const int width = w.ex->image().width();
+          float best_weight = -1.0f, support = 0.0f;
+          std::size_t pix = 0;
+          // Windows covering p: sparse voxels at p - (d - lo) (even) per slice axis.
+          int nu = 0, nv = 0;
+          for (int d = 0; d < n_; ++d) {
+            const int su = wrapped[s.u][p[s.u] - d + lo_ + n_];
+            if (su >= 0 && !(su & 1)) du_list[nu] = d, su_list[nu++] = su / 2;
+            const int sv = wrapped[s.v][p[s.v] - d + lo_ + n_];
+            if (sv >= 0 && !(sv & 1)) dv_list[nv] = d, sv_list[nv++] = sv / 2;
+          }
+          for (int a = 0; a < nv; ++a) {
+            const std::size_t row_sp = (std::size_t(p[s.axis]) * w.nv + sv_list[a]) * w.nu;
+            for (int b = 0; b < nu; ++b) {
+              const std::size_t sp = row_sp + su_list[b];
+              const int j = w.match[sp];
+              if (j < 0) continue;
+              const float wt = w.weight[sp];
+              support += wt;
+              if (wt <= best_weight) continue;  // ties: the first in scan order
+              best_weight = wt;
+              pix = std::size_t(w.ex->centre_v(j) - lo_ + dv_list[a]) * width + (w.ex->centre_u(j) - lo_ + du_list[b]);
+            }
+          }
+          if (best_weight >= 0.0f && support > best_support) best_support = support, best_view = i, best_pix = pix;
+        }
+        if (best_view < 0) continue;  // no window covers p: keep the optimised value
+        float* out = tex_.data() + tex_.offset(x, y, z);
+        const float* e = views_[best_view].ex->image().data() + best_pix * C_;
+        std::copy(e, e + C_, out);
+        if (!constraint_.empty()) {  // a requested target still wins by its weight
+          const float wc = std::clamp(constraint_.at(x, y, z, C_), 0.0f, 1.0f);
+          for (int c = 0; c < C_; ++c) out[c] = (1.0f - wc) * out[c] + wc * constraint_.at(x, y, z, c);
+        }
+        if (source) (*source)[tex_.voxel_index(x, y, z)] = std::int32_t((std::size_t(best_view) << 28) | best_pix);
+      }
+    }
+  });
+}
+
+}  // namespace exsynth::solid

@@ -40,9 +40,16 @@ class LevelSolver {
   /// Optimisation phase: every voxel from the matched neighbourhoods.
   void optimize(int iteration, StageProgress& progress);
 
+  /// Exemplar values: every voxel takes one exemplar texel, the one its
+  /// best-matching covering window puts there (see level_solver.cpp).
+  /// `source`, when given, receives per voxel the view and exemplar pixel taken
+  /// (view * 2^28 + pixel index; -1 = no window covered it: value kept).
+  void discrete(StageProgress& progress, std::vector<std::int32_t>* source = nullptr);
+
   /// Units of progress each phase reports (for StageProgress totals).
   std::size_t search_units() const;
   std::size_t optimize_units() const;
+  std::size_t discrete_units() const { return std::size_t(tex_.ny()) * tex_.nz(); }
 
  private:
   struct View {

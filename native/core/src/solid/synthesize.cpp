@@ -207,12 +207,14 @@ TextureResult optimize_texture(const Job& job, const TextureOptimizationOptions&
   }
 
   // Peak memory: the finest texture twice (upsampling), the sparse matches,
-  // weights and energies (double-buffered), the constraint pyramid and the
-  // exemplar analysis (neighbourhoods, coefficients, k-NN lists per thread).
+  // weights and energies (double-buffered), the exemplar-values sources, the
+  // constraint pyramid and the exemplar analysis (neighbourhoods,
+  // coefficients, k-NN lists per thread).
   // Each part's advice names its own cause.
   {
     const double voxels = double(job.finest.voxels());
     double texture_bytes = voxels * channels * 4.0 * 2.0 + voxels * 3.0 / 4.0 * 16.0;
+    if (opt.exemplar_values) texture_bytes += voxels * 4.0;  // TextureResult::source
     if (constraint_in && !constraint_in->empty()) texture_bytes += voxels * (channels + 1) * 4.0 * 8.0 / 7.0;
     double exemplar_bytes = 0;
     const Image* largest = images[0];
@@ -307,9 +309,12 @@ TextureResult optimize_texture(const Job& job, const TextureOptimizationOptions&
     if (!coarsest) solver->inherit_matches(*previous);
 
     const int iterations = coarsest ? 2 * opt.iterations : opt.iterations;
+    const bool finest = l == L - 1;
+    const bool exemplar_values = finest && opt.exemplar_values;
     StageProgress progress(ctx, stage, p0 + 0.1 * (p1 - p0), p1,
                            std::size_t(iterations) * (solver->search_units() + solver->optimize_units()) +
-                               (!coarsest && opt.coherent_upsampling ? solver->optimize_units() : 0));
+                               (!coarsest && opt.coherent_upsampling ? solver->optimize_units() : 0) +
+                               (exemplar_values ? solver->discrete_units() : 0));
     // Coherent upsampling: the finer level's texture is first rebuilt from the
     // inherited matches, i.e. from the finer exemplar's own texels, instead of
     // being searched from the trilinearly upsampled (blurred) coarse texture:
@@ -329,6 +334,13 @@ TextureResult optimize_texture(const Job& job, const TextureOptimizationOptions&
       result.energy_level.push_back(l);
       if (ctx) ctx->set_stage(stage + " optimise");
       solver->optimize(it, progress);
+    }
+    // Exemplar values (docs/solid.md, "Where the detail went"): the weighted
+    // mean of disagreeing windows is what blurs; the output takes the texels
+    // of the best-matching windows instead.
+    if (exemplar_values) {
+      if (ctx) ctx->set_stage(stage + " exemplar values");
+      solver->discrete(progress, &result.source);
     }
     previous = std::move(solver);
     prev_index = std::move(index);  // the solver's views point into these
