@@ -48,9 +48,10 @@ struct TexelFrames {
 TexelFrames build_texel_frames(const SubdivSurface& surface, TexelGrid grid,
                                const std::vector<Eigen::Vector3f>& field, ExecContext* ctx);
 
-/// Walk with the texel cache (see SubdivSurface::walk).
+/// Walk with the texel cache (see SubdivSurface::walk). landing_only: a
+/// looser tolerance, for walks that only need the texel they end in.
 bool walk_cached(const SubdivSurface& surface, const TexelFrames& frames, SurfacePoint& p,
-                 const Eigen::Vector3d& d);
+                 const Eigen::Vector3d& d, bool landing_only = false);
 
 /// The (2r+1)^2 sample points around texel t at spacing h in its frame:
 /// sample (l, m) (l, m in [-r, r], row-major over m then l) is reached by
