@@ -197,12 +197,11 @@ class MultiscaleSolver {
     }
   }
 
-  /// Walks the sample grid of radius r at spacing hh around p and copies the
-  /// values of the level-`lv` texels the samples land in.
   /// The texels of level `lv` the (2r+1)^2 samples at spacing hh around each
   /// texel of level l land in: walked once per level (in parallel) and read
   /// by every pass (the walks are most of the work on fine meshes, where
-  /// coarse neighbourhoods cross many faces).
+  /// coarse neighbourhoods cross many faces). Past a boundary a sample keeps
+  /// the texel where its walk stopped.
   std::vector<std::int32_t> landing_table(int l, int lv, int r, double hh) const {
     const int per = (2 * r + 1) * (2 * r + 1);
     const TexelGrid& g = grids_[std::size_t(l)];
@@ -214,30 +213,11 @@ class MultiscaleSolver {
         const SurfacePoint p = g.centre(t);
         const std::size_t t0 = frames_.grid.texel(p);
         const Eigen::Vector3d a = frames_.t1[t0].cast<double>() * hh, bb = frames_.t2[t0].cast<double>() * hh;
-        // Marching: each row starts one step from the previous row's start,
-        // each sample one step from its neighbour towards the centre column
-        // (the walk re-projects the step into each tangent plane). Walking
-        // every sample from the centre cost 2-3x more face crossings.
-        const int side = 2 * r + 1;
+        SurfacePoint pts[kMaxSamples];
+        bool valid[kMaxSamples];
+        march_points(surface_, frames_, p, a, bb, r, true, pts, valid);
         std::int32_t* row = tab.data() + t * std::size_t(per);
-        auto march_row = [&](SurfacePoint start, int m) {
-          row[(m + r) * side + r] = std::int32_t(to.texel(start));
-          for (int dir : {1, -1}) {
-            SurfacePoint q = start;
-            for (int i = 1; i <= r; ++i) {
-              walk_cached(surface_, frames_, q, double(dir) * a, true);
-              row[(m + r) * side + r + dir * i] = std::int32_t(to.texel(q));
-            }
-          }
-        };
-        march_row(p, 0);
-        for (int dir : {1, -1}) {
-          SurfacePoint start = p;
-          for (int m = 1; m <= r; ++m) {
-            walk_cached(surface_, frames_, start, -double(dir) * bb, true);
-            march_row(start, dir * m);
-          }
-        }
+        for (int k = 0; k < per; ++k) row[k] = std::int32_t(to.texel(pts[k]));
       }
     });
     return tab;

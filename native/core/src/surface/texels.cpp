@@ -113,6 +113,34 @@ void sample_points(const SubdivSurface& surface, const TexelFrames& frames, std:
     }
 }
 
+void march_points(const SubdivSurface& surface, const TexelFrames& frames, const SurfacePoint& c,
+                  const Eigen::Vector3d& a, const Eigen::Vector3d& b, int r, bool landing_only, SurfacePoint* out,
+                  bool* valid) {
+  const int side = 2 * r + 1;
+  auto march_row = [&](SurfacePoint start, bool ok, int m) {
+    out[(m + r) * side + r] = start;
+    valid[(m + r) * side + r] = ok;
+    for (int dir : {1, -1}) {
+      SurfacePoint q = start;
+      bool inside = ok;
+      for (int i = 1; i <= r; ++i) {
+        inside = walk_cached(surface, frames, q, double(dir) * a, landing_only) && inside;
+        out[(m + r) * side + r + dir * i] = q;
+        valid[(m + r) * side + r + dir * i] = inside;
+      }
+    }
+  };
+  march_row(c, true, 0);
+  for (int dir : {1, -1}) {
+    SurfacePoint start = c;
+    bool inside = true;
+    for (int m = 1; m <= r; ++m) {
+      inside = walk_cached(surface, frames, start, -double(dir) * b, landing_only) && inside;
+      march_row(start, inside, dir * m);
+    }
+  }
+}
+
 void sample_exemplar(const Image& ex, double x, double y, bool wrap, float* out) {
   const int w = ex.width(), h = ex.height(), c = ex.channels();
   if (wrap) {
