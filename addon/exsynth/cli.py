@@ -658,7 +658,9 @@ def _run_demo(args):
     os.makedirs(args.out, exist_ok=True)
     return (demo.run(bunny, args.out, resolution=args.resolution, samples=args.samples)
             or demo.run_solid(cow, stone, args.out, size=args.solid_size, samples=args.samples)
-            or demo.run_analogy(bunny, args.out, samples=args.samples))
+            or demo.run_analogy(bunny, args.out, samples=args.samples)
+            or demo.run_surface(cow, _input_file("--assets", os.path.join(args.assets, "textures", "drkwood2.png"), None),
+                                stone, args.out, samples=args.samples))
 
 
 # ---- argument checks ----------------------------------------------------------
