@@ -3,7 +3,8 @@
 invoke from a 3D viewport, watch progress, finish; invoke again, press Esc
 mid-run, check the scene is unchanged; then open the sidebar's ExSynth tab
 (the Solid Texture panels must draw) and run Solid Texture modally; run
-Geometric Texture modally (its panel must draw) and undo it. Needs a display, e.g. (xvfb package):
+Geometric Texture, Point Texture and Surface Texture modally (their panels
+must draw) and undo them. Needs a display, e.g. (xvfb package):
 
     EXSYNTH_ADDON_DIR=build/addon xvfb-run -a -s "-screen 0 1280x800x24" \
         blender --factory-startup --enable-event-simulate --python tests/blender/gui_smoke.py
@@ -250,6 +251,38 @@ def pts_finish():
 
 def pts_undone():
     check(names() == [], "one undo removes the Point Texture result")
+    state.update(step="surf_start")
+    return 0.1
+
+
+# ---- Surface Texture: its panel draws, its modal run finishes, Ctrl+Z undoes it
+def surf_start():
+    bpy.ops.mesh.primitive_cube_add(size=1.0)
+    bpy.context.active_object.name = "cube"
+    s = bpy.context.scene.exsynth
+    s.surface_exemplar = bpy.data.images.load(os.path.join(ROOT, "assets", "textures", "crackedground.png"))
+    s.surface_method, s.surface_size_mode, s.surface_face_resolution = 'COHERENT', 'FACE', 16
+    _record_draws(bpy.types.EXSYNTH_PT_surface)
+    _in_viewport(lambda: bpy.ops.ed.undo_push(message="before Surface Texture"))
+    check(invoke_in_viewport("surface_texture") == {'RUNNING_MODAL'}, "Surface Texture runs modal")
+    state.update(step="surf_finish", t0=time.monotonic())
+    return 0.05
+
+
+def surf_finish():
+    if "cube_surface" not in bpy.data.objects:
+        if time.monotonic() - state["t0"] > 60:
+            check(False, "Surface Texture finishes within a minute")
+        return 0.05
+    check(names() == ["cube", "cube_surface"], "Surface Texture adds 'cube_surface'")
+    check("EXSYNTH_PT_surface" in drawn, "the Surface Texture panel draws without errors")
+    _in_viewport(lambda: bpy.ops.ed.undo())
+    state.update(step="surf_undone")
+    return 0.3
+
+
+def surf_undone():
+    check(names() == ["cube"], "one undo removes the Surface Texture result")
     print("gui_smoke: all passed", flush=True)
     os._exit(0)
 
@@ -258,5 +291,6 @@ STEPS = {"start": start, "wait_finish": wait_finish, "press_esc": press_esc, "af
          "solid_start": solid_start, "find_tab": find_tab, "solid_finish": solid_finish,
          "geo_start": geo_start, "geo_finish": geo_finish, "geo_undone": geo_undone,
          "geo_pair_drawn": geo_pair_drawn, "pts_start": pts_start, "pts_finish": pts_finish,
-         "pts_undone": pts_undone}
+         "pts_undone": pts_undone, "surf_start": surf_start, "surf_finish": surf_finish,
+         "surf_undone": surf_undone}
 bpy.app.timers.register(step, first_interval=1.0)
