@@ -233,7 +233,9 @@ void run_coherent(const SubdivSurface& surface, const TexelFrames& fr, const Ima
 
   const int passes = std::max(1, opt.coherent_passes);
   StageProgress progress(ctx, "coherent synthesis", 0.0, 1.0, count * std::size_t(passes));
-  // Pass 1, in synthesis order: each texel sees the ones before it (causal).
+  // Pass 1, in synthesis order: each texel sees the ones before it (causal;
+  // the same waves here left 1/9 of the texels random and every other texel
+  // seeing few neighbours: flat-plane window distance 0.76 vs 0.29).
   CoherentSolver::Scratch scratch;
   for (std::size_t i = 0; i < count; ++i) {
     if ((i & 4095) == 0) progress.check();
