@@ -6,7 +6,14 @@
 // the core). Texel density is searched once, before timing, to hit the count.
 #include <benchmark/benchmark.h>
 
+#include <array>
+#include <chrono>
 #include <cmath>
+#include <cstdio>
+#include <ctime>
+#include <map>
+#include <string>
+#include <vector>
 
 #include "../tests/cpp/support/load_obj.hpp"
 #include "../tests/cpp/support/textures.hpp"
@@ -44,13 +51,55 @@ exsynth::SurfaceSynthesisOptions options_for(double texels, exsynth::SurfaceMeth
   return o;
 }
 
-void run(benchmark::State& state, double texels, int exemplar, exsynth::SurfaceMethod method) {
+double process_cpu_seconds() {
+  timespec ts{};
+  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
+  return double(ts.tv_sec) + 1e-9 * double(ts.tv_nsec);
+}
+
+/// Wall and process CPU time per stage (ExecContext stage names), printed
+/// to stderr after each run: where the time goes.
+class StageTimer {
+ public:
+  explicit StageTimer(exsynth::ExecContext& ctx) : ctx_(ctx) {
+    ctx.on_stage([this] { switch_to(ctx_.stage()); });
+  }
+  void finish(const char* title) {
+    switch_to("");
+    std::fprintf(stderr, "%s: stage wall / process CPU (s)\n", title);
+    for (const auto& [name, t] : totals_) std::fprintf(stderr, "  %-44s %7.2f %7.2f\n", name.c_str(), t[0], t[1]);
+  }
+
+ private:
+  void switch_to(const std::string& stage) {
+    const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
+    const double cpu = process_cpu_seconds();
+    if (!current_.empty()) {
+      totals_[current_][0] += wall - wall_;
+      totals_[current_][1] += cpu - cpu_;
+    }
+    current_ = stage;
+    wall_ = wall;
+    cpu_ = cpu;
+  }
+  exsynth::ExecContext& ctx_;
+  std::string current_;
+  double wall_ = 0, cpu_ = 0;
+  std::map<std::string, std::array<double, 2>> totals_;
+};
+
+void run(benchmark::State& state, const char* name, double texels, int exemplar, exsynth::SurfaceMethod method) {
   const exsynth::SurfaceSynthesisOptions o = options_for(texels, method);
   const exsynth::Image ex = exsynth::testing::disc_texture(exemplar, exemplar, 3, 7, exemplar * exemplar / 60,
                                                            float(exemplar) / 24);
   std::size_t count = 0;
   for (auto _ : state) {
-    const exsynth::SurfaceTexture t = exsynth::synthesize_surface(cow(), ex, o);
+    exsynth::ExecContext ctx;
+    StageTimer timer(ctx);
+    const double cpu0 = process_cpu_seconds();
+    const exsynth::SurfaceTexture t = exsynth::synthesize_surface(cow(), ex, o, &ctx);
+    state.counters["process_cpu_s"] = process_cpu_seconds() - cpu0;
+    timer.finish(name);
     count = t.texel_count();
     benchmark::DoNotOptimize(t.texels.data());
   }
@@ -59,9 +108,9 @@ void run(benchmark::State& state, double texels, int exemplar, exsynth::SurfaceM
   state.counters["texels_per_unit"] = o.texels_per_unit;
 }
 
-void BM_SurfaceCoherent(benchmark::State& state) { run(state, 370e3, 96, exsynth::SurfaceMethod::Coherent); }
-void BM_SurfaceMultiscale64(benchmark::State& state) { run(state, 400e3, 64, exsynth::SurfaceMethod::Multiscale); }
-void BM_SurfaceMultiscale192(benchmark::State& state) { run(state, 400e3, 192, exsynth::SurfaceMethod::Multiscale); }
+void BM_SurfaceCoherent(benchmark::State& state) { run(state, "coherent 96", 370e3, 96, exsynth::SurfaceMethod::Coherent); }
+void BM_SurfaceMultiscale64(benchmark::State& state) { run(state, "multiscale 64", 400e3, 64, exsynth::SurfaceMethod::Multiscale); }
+void BM_SurfaceMultiscale192(benchmark::State& state) { run(state, "multiscale 192", 400e3, 192, exsynth::SurfaceMethod::Multiscale); }
 
 /// Atlas + limit mesh for the coherent result (the rest of the job).
 void BM_SurfaceAtlasAndMesh(benchmark::State& state) {

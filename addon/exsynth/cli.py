@@ -254,10 +254,11 @@ def _parser():
     p.set_defaults(run=_run_analogy)
 
     p = sub.add_parser("demo", help="voxelize the bundled bunny, solid-texture the cow, give the bunny "
-                       "spikes and grooves; render PNGs",
+                       "spikes and grooves, texture the cow's surface; render PNGs",
                        description="Voxelize assets/meshes/bunny.obj, solid-texture assets/meshes/cow.obj "
-                       "cut open, give the bunny spikes and grooves (Geometric Texture), and render them "
-                       "with Cycles.")
+                       "cut open, give the bunny spikes and grooves (Geometric Texture), texture the cow's "
+                       "subdivision surface (Surface Texture: coherent, multiscale, with height), and "
+                       "render them with Cycles.")
     p.add_argument("--assets", required=True, help="the repository's assets/ folder")
     p.add_argument("--out", required=True, help="folder for the PNGs")
     p.add_argument("--resolution", type=_int, default=96, help="voxels along the longest side (default 96)")
@@ -669,7 +670,9 @@ def _run_demo(args):
     os.makedirs(args.out, exist_ok=True)
     return (demo.run(bunny, args.out, resolution=args.resolution, samples=args.samples)
             or demo.run_solid(cow, stone, args.out, size=args.solid_size, samples=args.samples)
-            or demo.run_analogy(bunny, args.out, samples=args.samples))
+            or demo.run_analogy(bunny, args.out, samples=args.samples)
+            or demo.run_surface(cow, _input_file("--assets", os.path.join(args.assets, "textures", "drkwood2.png"), None),
+                                stone, args.out, samples=args.samples))
 
 
 # ---- argument checks ----------------------------------------------------------

@@ -92,7 +92,7 @@ std::vector<Eigen::Vector3f> to_field(const py::handle& arg, std::size_t vertice
 
 constexpr const char* kOptionNames =
     "method, texels_per_unit, face_resolution, min_face_resolution, max_face_resolution, exemplar_scale, "
-    "coherent_radius, coherent_passes, levels, fine_neighborhood, coarse_neighborhood, knn, knn_tolerance, "
+    "coherent_radius, coherent_passes, levels, fine_neighborhood, coarse_neighborhood, knn, knn_tolerance, coherence, "
     "pca_variance, max_pca_dims, tileable_exemplar, field_axis, memory_budget, seed, gutter, segments, "
     "displacement_(channel, scale, midlevel)";  // compact: the whole message stays under 400 characters
 
@@ -122,6 +122,7 @@ void set_options(SurfaceSynthesisOptions& o, SurfaceOutputOptions& out, const py
     else if (k == "coarse_neighborhood") o.coarse_neighborhood = int_arg(v, k, 1, 11, "odd");
     else if (k == "knn") o.knn = int_arg(v, k, 1, 64);
     else if (k == "knn_tolerance") o.knn_tolerance = real_arg(v, k, 0.0, kInf);
+    else if (k == "coherence") o.coherence = real_arg(v, k, 0.0, kInf);
     else if (k == "pca_variance") o.pca_variance = real_arg(v, k, 0.0, 1.0, Ends::OpenLow);
     else if (k == "max_pca_dims") o.max_pca_dims = int_arg(v, k, 1, 4096);
     else if (k == "tileable_exemplar") o.tileable_exemplar = bool_arg(v, k);
@@ -199,8 +200,8 @@ synthesized together (colour, alpha, height). field (V, 3): tangent vector per v
 exsynth_field or a preset); None = a smooth field from field_axis.
 Options (keywords): method='coherent'|'multiscale', texels_per_unit=0 (0 = face_resolution),
 face_resolution=16, min_face_resolution=2, max_face_resolution=512, exemplar_scale=1,
-coherent_radius=2, coherent_passes=2, levels=0 (auto), fine_neighborhood=9, coarse_neighborhood=5, knn=8,
-knn_tolerance=0.1, pca_variance=0.97, max_pca_dims=24, tileable_exemplar=False,
+coherent_radius=2, coherent_passes=2, levels=0 (auto), fine_neighborhood=9, coarse_neighborhood=5, knn=4,
+knn_tolerance=0, coherence=1.0, pca_variance=0.97, max_pca_dims=24, tileable_exemplar=False,
 field_axis=(0, 0, 1), memory_budget=0 (default), seed=0; output: gutter=2, segments=2 (per n-gon
 sub-face; quads get 2x), displacement_channel=-1, displacement_scale=0, displacement_midlevel=0.5.
 Returns {'atlas': (H, W, C) float32 (row 0 = top), 'vertices': (N, 3), 'normals': (N, 3),

@@ -3,8 +3,8 @@
 invoke from a 3D viewport, watch progress, finish; invoke again, press Esc
 mid-run, check the scene is unchanged; then open the sidebar's ExSynth tab
 (the Solid Texture panels must draw) and run Solid Texture modally; run
-Geometric Texture modally (its panel must draw) and undo it; Point Texture
-likewise; then paint a direction field: the overlay draws, a simulated
+Geometric Texture, Point Texture and Surface Texture modally (their panels
+must draw) and undo them; then paint a direction field: the overlay draws, a simulated
 stroke turns the field its way, Esc ends, undo restores it, and a
 screenshot goes to $EXSYNTH_SCREENSHOT (default build/gui_paint.png). Needs a display, e.g. (xvfb package):
 
@@ -256,6 +256,38 @@ def pts_finish():
 
 def pts_undone():
     check(names() == [], "one undo removes the Point Texture result")
+    state.update(step="surf_start")
+    return 0.1
+
+
+# ---- Surface Texture: its panel draws, its modal run finishes, Ctrl+Z undoes it
+def surf_start():
+    bpy.ops.mesh.primitive_cube_add(size=1.0)
+    bpy.context.active_object.name = "cube"
+    s = bpy.context.scene.exsynth
+    s.surface_exemplar = bpy.data.images.load(os.path.join(ROOT, "assets", "textures", "crackedground.png"))
+    s.surface_method, s.surface_size_mode, s.surface_face_resolution = 'COHERENT', 'FACE', 16
+    _record_draws(bpy.types.EXSYNTH_PT_surface)
+    _in_viewport(lambda: bpy.ops.ed.undo_push(message="before Surface Texture"))
+    check(invoke_in_viewport("surface_texture") == {'RUNNING_MODAL'}, "Surface Texture runs modal")
+    state.update(step="surf_finish", t0=time.monotonic())
+    return 0.05
+
+
+def surf_finish():
+    if "cube_surface" not in bpy.data.objects:
+        if time.monotonic() - state["t0"] > 60:
+            check(False, "Surface Texture finishes within a minute")
+        return 0.05
+    check(names() == ["cube", "cube_surface"], "Surface Texture adds 'cube_surface'")
+    check("EXSYNTH_PT_surface" in drawn, "the Surface Texture panel draws without errors")
+    _in_viewport(lambda: bpy.ops.ed.undo())
+    state.update(step="surf_undone")
+    return 0.3
+
+
+def surf_undone():
+    check(names() == ["cube"], "one undo removes the Surface Texture result")
     state.update(step="paint_start")
     return 0.1
 
@@ -446,7 +478,8 @@ STEPS = {"start": start, "wait_finish": wait_finish, "press_esc": press_esc, "af
          "solid_start": solid_start, "find_tab": find_tab, "solid_finish": solid_finish,
          "geo_start": geo_start, "geo_finish": geo_finish, "geo_undone": geo_undone,
          "geo_pair_drawn": geo_pair_drawn, "pts_start": pts_start, "pts_finish": pts_finish,
-         "pts_undone": pts_undone, "paint_start": paint_start, "paint_overlay": paint_overlay,
+         "pts_undone": pts_undone, "surf_start": surf_start, "surf_finish": surf_finish,
+         "surf_undone": surf_undone, "paint_start": paint_start, "paint_overlay": paint_overlay,
          "paint_release": paint_release, "paint_diffused": paint_diffused, "paint_tab": paint_tab,
          "paint_screenshot": paint_screenshot,
          "paint_ended": paint_ended, "paint_undone": paint_undone}

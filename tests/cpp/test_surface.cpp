@@ -267,19 +267,28 @@ TEST(SurfaceNeighbourhood, SampledAcrossFaceEdgesEqualsThePlainGrid) {
   const int f = 2 * 6 + 2;
   const std::size_t t = grid.offset[std::size_t(f)] + 7 * 8 + 7;  // top-right texel of face (2, 2)
   const double h = 0.125;
-  SurfacePoint pts[25];
-  bool valid[25];
-  surface::sample_points(s, fr, t, h, 2, pts, valid);
   const V3d c = s.evaluate(grid.centre(t)).position;
   const V3d e1(std::cos(a), std::sin(a), 0), e2(-std::sin(a), std::cos(a), 0);
-  std::set<int> faces;
-  for (int k = 0; k < 25; ++k) {
-    const int l = k % 5 - 2, mm = k / 5 - 2;
-    ASSERT_TRUE(valid[k]);
-    faces.insert(pts[k].face);
-    EXPECT_NEAR((s.evaluate(pts[k]).position - (c + h * (l * e1 - mm * e2))).norm(), 0.0, 1e-6) << l << "," << mm;
+  // Walked from the centre (sample_points), and marched row by row as the
+  // synthesis does (march_points, with the tight and the landing tolerance).
+  for (int how = 0; how < 3; ++how) {
+    SurfacePoint pts[25];
+    bool valid[25];
+    if (how == 0)
+      surface::sample_points(s, fr, t, h, 2, pts, valid);
+    else
+      surface::march_points(s, fr, grid.centre(t), h * fr.t1[t].cast<double>(), h * fr.t2[t].cast<double>(), 2,
+                            how == 2, pts, valid);
+    std::set<int> faces;
+    for (int k = 0; k < 25; ++k) {
+      const int l = k % 5 - 2, mm = k / 5 - 2;
+      ASSERT_TRUE(valid[k]);
+      faces.insert(pts[k].face);
+      EXPECT_NEAR((s.evaluate(pts[k]).position - (c + h * (l * e1 - mm * e2))).norm(), 0.0, 1e-6)
+          << how << ": " << l << "," << mm;
+    }
+    EXPECT_GE(faces.size(), 3u);
   }
-  EXPECT_GE(faces.size(), 3u);
 }
 
 TEST(SurfaceNeighbourhood, SampledAtAnExtraordinaryVertexEqualsThePlainGrid) {
@@ -293,20 +302,26 @@ TEST(SurfaceNeighbourhood, SampledAtAnExtraordinaryVertexEqualsThePlainGrid) {
       surface::build_texel_frames(s, grid, constant_field(m.vertices.size(), V3(1, 0, 0)), nullptr);
   const std::size_t t = grid.offset[0];  // texel (0, 0) of face 0: at the centre vertex
   const double h = 0.08;
-  SurfacePoint pts[25];
-  bool valid[25];
-  surface::sample_points(s, fr, t, h, 2, pts, valid);
   const V3d c = s.evaluate(grid.centre(t)).position;
   const V3d e1 = fr.t1[t].cast<double>(), e2 = fr.t2[t].cast<double>();
   EXPECT_NEAR(e2.dot(V3d(0, 0, 1).cross(e1)), 1.0, 1e-6);
-  std::set<int> faces;
-  for (int k = 0; k < 25; ++k) {
-    const int l = k % 5 - 2, mm = k / 5 - 2;
-    ASSERT_TRUE(valid[k]);
-    faces.insert(pts[k].face);
-    EXPECT_NEAR((s.evaluate(pts[k]).position - (c + h * (l * e1 - mm * e2))).norm(), 0.0, 0.05 * h);
+  for (int how = 0; how < 3; ++how) {
+    SurfacePoint pts[25];
+    bool valid[25];
+    if (how == 0)
+      surface::sample_points(s, fr, t, h, 2, pts, valid);
+    else
+      surface::march_points(s, fr, grid.centre(t), h * e1, h * e2, 2, how == 2, pts, valid);
+    std::set<int> faces;
+    for (int k = 0; k < 25; ++k) {
+      const int l = k % 5 - 2, mm = k / 5 - 2;
+      ASSERT_TRUE(valid[k]);
+      faces.insert(pts[k].face);
+      EXPECT_NEAR((s.evaluate(pts[k]).position - (c + h * (l * e1 - mm * e2))).norm(), 0.0, 0.05 * h)
+          << how << ": " << l << "," << mm;
+    }
+    EXPECT_GE(faces.size(), 4u);  // around the valence-5 vertex
   }
-  EXPECT_GE(faces.size(), 4u);  // around the valence-5 vertex
 }
 
 TEST(SurfaceNeighbourhood, ChartJacobianMatchesFiniteDifferencesOnACurvedSurface) {

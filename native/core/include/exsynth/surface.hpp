@@ -145,8 +145,12 @@ struct SurfaceSynthesisOptions {
   /// at most 4), neighbourhood sizes of the current and the coarser level.
   int levels = 0;
   int fine_neighborhood = 9, coarse_neighborhood = 5;
-  int knn = 8;                      ///< candidates from the k-d tree
-  double knn_tolerance = 0.1;       ///< random pick among those within 10 % of the best
+  int knn = 4;                      ///< candidates from the k-d tree (re-ranked by exact distance)
+  double knn_tolerance = 0.0;       ///< random pick among those within this fraction of the best (paper: 0.1)
+  /// Multiscale: a coherent candidate (a neighbour's source shifted back by
+  /// its offset) is taken unless the best k-d tree match is more than
+  /// (1 + coherence) closer in squared distance; 0 = the k-d tree alone.
+  double coherence = 1.0;
   double pca_variance = 0.97;
   int max_pca_dims = 24;
   bool tileable_exemplar = false;   ///< wrap exemplar lookups (else clamp / reject)

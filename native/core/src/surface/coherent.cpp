@@ -90,11 +90,11 @@ NeighbourTable neighbour_table(const SubdivSurface& surface, const TexelFrames& 
   tab.offset.resize(count * std::size_t(tab.per));
   StageProgress progress(ctx, "surface neighbourhoods", 0.0, 1.0, count);
   parallel_chunks(count, 1024, progress, [&](std::size_t b, std::size_t e) {
-    SurfacePoint pts[121];
-    bool valid[121];
+    SurfacePoint pts[kMaxSamples];
+    bool valid[kMaxSamples];
     for (std::size_t t = b; t < e; ++t) {
-      sample_points(surface, fr, t, h, r, pts, valid);
       const Eigen::Vector3d a = fr.t1[t].cast<double>(), bb = fr.t2[t].cast<double>();
+      march_points(surface, fr, fr.grid.centre(t), h * a, h * bb, r, true, pts, valid);
       std::size_t at = t * std::size_t(tab.per);
       for (int k = 0; k < n; ++k) {
         const int l = k % (2 * r + 1) - r, m = k / (2 * r + 1) - r;
@@ -118,83 +118,144 @@ NeighbourTable neighbour_table(const SubdivSurface& surface, const TexelFrames& 
 
 }  // namespace
 
+namespace {
+
+/// The per-texel step of the coherent method over a built neighbour table.
+class CoherentSolver {
+ public:
+  CoherentSolver(const NeighbourTable& tab, const Image& ex, const SurfaceSynthesisOptions& opt, SurfaceTexture& out,
+                 std::vector<char>& done)
+      : tab_(tab), ex_(ex), opt_(opt), out_(out), done_(done), C_(ex.channels()) {}
+
+  /// Per-thread buffers.
+  struct Scratch {
+    std::vector<Eigen::Vector2d> cands;
+    std::vector<int> known;  // neighbour slots already synthesized
+    std::vector<float> value;
+  };
+
+  /// The best source for texel t given the texels synthesized so far.
+  Eigen::Vector2d choose(std::size_t t, Scratch& s) const {
+    const int per = tab_.per;
+    const std::int32_t* nb = tab_.texel.data() + t * std::size_t(per);
+    const Eigen::Vector2f* off = tab_.offset.data() + t * std::size_t(per);
+    const double W = ex_.width(), H = ex_.height();
+    const bool wrap = opt_.tileable_exemplar;
+    auto inside = [&](Eigen::Vector2d& c) {
+      if (wrap) {
+        c.x() = std::fmod(c.x(), W);
+        if (c.x() < 0) c.x() += W;
+        c.y() = std::fmod(c.y(), H);
+        if (c.y() < 0) c.y() += H;
+        return true;
+      }
+      return c.x() >= 0 && c.y() >= 0 && c.x() <= W - 1 && c.y() <= H - 1;
+    };
+    s.value.resize(std::size_t(C_));
+    s.known.clear();
+    s.cands.clear();
+    for (int j = 0; j < per; ++j) {
+      if (nb[j] < 0 || std::size_t(nb[j]) == t || !done_[std::size_t(nb[j])]) continue;
+      // Later passes: every neighbour is known; the texel's own source competes too.
+      s.known.push_back(j);
+      const std::size_t q = std::size_t(nb[j]);
+      Eigen::Vector2d c(out_.source[q * 2] - off[j].x(), out_.source[q * 2 + 1] - off[j].y());
+      if (!inside(c)) continue;
+      bool seen = false;
+      for (const auto& o : s.cands) seen = seen || (o - c).squaredNorm() < 0.0625;
+      if (!seen) s.cands.push_back(c);
+    }
+    if (done_[t]) s.cands.emplace_back(out_.source[t * 2], out_.source[t * 2 + 1]);
+    if (s.cands.empty()) {
+      IndexRng rng(opt_.seed, t);
+      return Eigen::Vector2d(double(rng.below(std::uint64_t(W))), double(rng.below(std::uint64_t(H))));
+    }
+    Eigen::Vector2d best = s.cands[0];
+    double best_d = std::numeric_limits<double>::infinity();
+    for (const auto& c : s.cands) {
+      double d = 0;
+      for (std::size_t i = 0; i < s.known.size() && d < best_d; ++i) {
+        const int j = s.known[i];
+        nearest_exemplar(ex_, c.x() + off[j].x(), c.y() + off[j].y(), wrap, s.value.data());
+        const float* tq = out_.texels.data() + std::size_t(nb[j]) * std::size_t(C_);
+        for (int ch = 0; ch < C_; ++ch)
+          d += double(s.value[std::size_t(ch)] - tq[ch]) * (s.value[std::size_t(ch)] - tq[ch]);
+      }
+      if (d < best_d) {
+        best_d = d;
+        best = c;
+      }
+    }
+    return best;
+  }
+
+  void set(std::size_t t, const Eigen::Vector2d& src) {
+    nearest_exemplar(ex_, src.x(), src.y(), opt_.tileable_exemplar, out_.texels.data() + t * std::size_t(C_));
+    out_.source[t * 2] = float(src.x());
+    out_.source[t * 2 + 1] = float(src.y());
+    done_[t] = 1;
+  }
+
+ private:
+  const NeighbourTable& tab_;
+  const Image& ex_;
+  const SurfaceSynthesisOptions& opt_;
+  SurfaceTexture& out_;
+  std::vector<char>& done_;
+  int C_;
+};
+
+/// Texels in waves by their position in the face map, (i mod 3) + 3 (j mod
+/// 3), each in synthesis order: the passes after the first (every neighbour
+/// known) search a wave's texels in parallel against the waves before it.
+std::vector<std::vector<std::size_t>> texel_waves(const TexelGrid& g, const std::vector<std::size_t>& order) {
+  std::vector<std::vector<std::size_t>> w(9);
+  for (std::size_t t : order) {
+    const int f = g.face_of[t], r = g.res[std::size_t(f)];
+    const std::size_t k = t - g.offset[std::size_t(f)];
+    w[std::size_t(int(k % std::size_t(r)) % 3 + 3 * (int(k / std::size_t(r)) % 3))].push_back(t);
+  }
+  return w;
+}
+
+}  // namespace
+
 void run_coherent(const SubdivSurface& surface, const TexelFrames& fr, const Image& ex,
                   const SurfaceSynthesisOptions& opt, SurfaceTexture& out, ExecContext* ctx) {
   const int C = ex.channels();
-  const double h = out.sample_spacing;
-  const bool wrap = opt.tileable_exemplar;
   const std::size_t count = fr.grid.size();
-  const NeighbourTable tab = neighbour_table(surface, fr, h, opt.coherent_radius, ctx);
-  const int per = tab.per;
+  const NeighbourTable tab = neighbour_table(surface, fr, out.sample_spacing, opt.coherent_radius, ctx);
   const std::vector<std::size_t> order = synthesis_order(surface, fr.grid);
   std::vector<char> done(count, 0);
   out.texels.assign(count * std::size_t(C), 0.0f);
   out.source.assign(count * 2, 0.0f);
-
-  std::vector<Eigen::Vector2d> cands;
-  std::vector<int> known;  // neighbour slots already synthesized
-  std::vector<float> value(static_cast<std::size_t>(C));
-  const double W = ex.width(), H = ex.height();
-  auto inside = [&](Eigen::Vector2d& c) {
-    if (wrap) {
-      c.x() = std::fmod(c.x(), W);
-      if (c.x() < 0) c.x() += W;
-      c.y() = std::fmod(c.y(), H);
-      if (c.y() < 0) c.y() += H;
-      return true;
-    }
-    return c.x() >= 0 && c.y() >= 0 && c.x() <= W - 1 && c.y() <= H - 1;
-  };
+  CoherentSolver solver(tab, ex, opt, out, done);
 
   const int passes = std::max(1, opt.coherent_passes);
   StageProgress progress(ctx, "coherent synthesis", 0.0, 1.0, count * std::size_t(passes));
-  for (std::size_t k = 0; k < count * std::size_t(passes); ++k) {
-    if ((k & 4095) == 0) {
-      progress.check();
-      if (k) progress.advance(4096);
-    }
-    const std::size_t t = order[k % count];
-    const std::int32_t* nb = tab.texel.data() + t * std::size_t(per);
-    const Eigen::Vector2f* off = tab.offset.data() + t * std::size_t(per);
-    known.clear();
-    cands.clear();
-    for (int s = 0; s < per; ++s) {
-      if (nb[s] < 0 || std::size_t(nb[s]) == t || !done[std::size_t(nb[s])]) continue;
-      // Later passes: every neighbour is known; the texel's own source competes too.
-      known.push_back(s);
-      const std::size_t q = std::size_t(nb[s]);
-      Eigen::Vector2d c(out.source[q * 2] - off[s].x(), out.source[q * 2 + 1] - off[s].y());
-      if (!inside(c)) continue;
-      bool seen = false;
-      for (const auto& o : cands) seen = seen || (o - c).squaredNorm() < 0.0625;
-      if (!seen) cands.push_back(c);
-    }
-    if (done[t]) cands.emplace_back(out.source[t * 2], out.source[t * 2 + 1]);
-    Eigen::Vector2d best;
-    if (cands.empty()) {
-      IndexRng rng(opt.seed, t);
-      best = Eigen::Vector2d(double(rng.below(std::uint64_t(W))), double(rng.below(std::uint64_t(H))));
-    } else {
-      double best_d = std::numeric_limits<double>::infinity();
-      for (const auto& c : cands) {
-        double d = 0;
-        for (std::size_t i = 0; i < known.size() && d < best_d; ++i) {
-          const int s = known[i];
-          nearest_exemplar(ex, c.x() + off[s].x(), c.y() + off[s].y(), wrap, value.data());
-          const float* tq = out.texels.data() + std::size_t(nb[s]) * std::size_t(C);
-          for (int ch = 0; ch < C; ++ch) d += double(value[std::size_t(ch)] - tq[ch]) * (value[std::size_t(ch)] - tq[ch]);
-        }
-        if (d < best_d) {
-          best_d = d;
-          best = c;
-        }
-      }
-    }
-    nearest_exemplar(ex, best.x(), best.y(), wrap, out.texels.data() + t * std::size_t(C));
-    out.source[t * 2] = float(best.x());
-    out.source[t * 2 + 1] = float(best.y());
-    done[t] = 1;
+  // Pass 1, in synthesis order: each texel sees the ones before it (causal;
+  // the same waves here left 1/9 of the texels random and every other texel
+  // seeing few neighbours: flat-plane window distance 0.76 vs 0.29).
+  CoherentSolver::Scratch scratch;
+  for (std::size_t i = 0; i < count; ++i) {
+    if ((i & 4095) == 0) progress.check();
+    solver.set(order[i], solver.choose(order[i], scratch));
   }
+  progress.advance(count);
+  // Later passes: all neighbours known; in parallel waves (deterministic:
+  // a wave reads only the waves before it and the previous pass). Flat-plane
+  // window distance (5 seeds) 0.290 both with the waves and in synthesis order.
+  const std::vector<std::vector<std::size_t>> waves = texel_waves(fr.grid, order);
+  std::vector<Eigen::Vector2d> next;
+  for (int pass = 1; pass < passes; ++pass)
+    for (const std::vector<std::size_t>& wave : waves) {
+      next.resize(wave.size());
+      parallel_chunks(wave.size(), 1024, progress, [&](std::size_t b, std::size_t e) {
+        CoherentSolver::Scratch s;
+        for (std::size_t i = b; i < e; ++i) next[i] = solver.choose(wave[i], s);
+      });
+      for (std::size_t i = 0; i < wave.size(); ++i) solver.set(wave[i], next[i]);
+    }
 }
 
 }  // namespace exsynth::surface

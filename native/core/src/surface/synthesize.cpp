@@ -30,6 +30,7 @@ void validate_options(const SurfaceSynthesisOptions& o) {
   if (o.levels < 0 || o.levels > 6) throw InvalidInput("levels must be in [0, 6] (0 = automatic)");
   if (o.knn < 1 || o.knn > 64) throw InvalidInput("knn must be in [1, 64]");
   if (!(o.knn_tolerance >= 0)) throw InvalidInput("knn_tolerance must be >= 0");
+  if (!(o.coherence >= 0) || !std::isfinite(o.coherence)) throw InvalidInput("coherence must be >= 0");
   if (!(o.pca_variance > 0 && o.pca_variance <= 1)) throw InvalidInput("pca_variance must be in (0, 1]");
   if (o.max_pca_dims < 1) throw InvalidInput("max_pca_dims must be >= 1");
 }
@@ -48,17 +49,26 @@ double bytes_per_texel(const SurfaceSynthesisOptions& o, int channels) {
 
 }  // namespace
 
-std::vector<int> surface_face_resolutions(const SubdivSurface& surface, const SurfaceSynthesisOptions& opt) {
-  validate_options(opt);
-  std::vector<int> res(std::size_t(surface.ptex_face_count()), opt.face_resolution);
+namespace {
+
+std::vector<int> face_resolutions(const std::vector<double>& areas, const SurfaceSynthesisOptions& opt) {
+  std::vector<int> res(areas.size(), opt.face_resolution);
   if (opt.texels_per_unit > 0) {
-    const std::vector<double> areas = surface.ptex_face_areas();
     for (std::size_t f = 0; f < res.size(); ++f) {
       const double side = std::ceil(opt.texels_per_unit * std::sqrt(std::max(areas[f], 0.0)) - 1e-9);
       res[f] = int(std::clamp(side, double(opt.min_face_resolution), double(opt.max_face_resolution)));
     }
   }
   return res;
+}
+
+}  // namespace
+
+std::vector<int> surface_face_resolutions(const SubdivSurface& surface, const SurfaceSynthesisOptions& opt) {
+  validate_options(opt);
+  return face_resolutions(opt.texels_per_unit > 0 ? surface.ptex_face_areas()
+                                                  : std::vector<double>(std::size_t(surface.ptex_face_count()), 0.0),
+                          opt);
 }
 
 SurfaceTexture synthesize_surface(const SubdivSurface& surface, const Image& exemplar,
@@ -81,7 +91,8 @@ SurfaceTexture synthesize_surface(const SubdivSurface& surface, const Image& exe
       if (!v.allFinite()) throw InvalidInput("field has non-finite vectors");
   }
 
-  std::vector<int> res = surface_face_resolutions(surface, opt);
+  const std::vector<double> areas = surface.ptex_face_areas();
+  std::vector<int> res = face_resolutions(areas, opt);
   double texels = 0, area_texels = 0;
   for (int r : res) texels += double(r) * r;
   check_memory_budget(texels * bytes_per_texel(opt, exemplar.channels()), opt.memory_budget,
@@ -95,7 +106,6 @@ SurfaceTexture synthesize_surface(const SubdivSurface& surface, const Image& exe
   out.face_offset = grid.offset;
   // Sample spacing: the mean texel size (surface length per texel), over the
   // exemplar scale, so one exemplar pixel covers about one texel.
-  const std::vector<double> areas = surface.ptex_face_areas();
   double total_area = 0;
   for (std::size_t f = 0; f < res.size(); ++f) {
     total_area += areas[f];

@@ -37,8 +37,13 @@ TexelGrid TexelGrid::coarser() const {
 }
 
 LimitFrame TexelFrames::approx(const SurfacePoint& p) const {
-  const std::size_t t = grid.texel(p);
-  const SurfacePoint c = grid.centre(t);
+  // grid.texel and grid.centre in one (no integer division: walks call this
+  // at every step).
+  const int r = grid.res[std::size_t(p.face)];
+  const int i = std::clamp(int(std::floor(p.u * r)), 0, r - 1);
+  const int j = std::clamp(int(std::floor(p.v * r)), 0, r - 1);
+  const std::size_t t = grid.offset[std::size_t(p.face)] + std::size_t(j) * std::size_t(r) + std::size_t(i);
+  const SurfacePoint c{p.face, (i + 0.5) / r, (j + 0.5) / r};
   LimitFrame f;
   f.du = du[t].cast<double>();
   f.dv = dv[t].cast<double>();
@@ -85,11 +90,14 @@ TexelFrames build_texel_frames(const SubdivSurface& surface, TexelGrid grid,
 // The cache is linear per texel (no need for short steps) and only
 // piecewise smooth (loose tolerance, few corrections, slide along edges).
 constexpr WalkParams kCachedWalk{1e-3, 1.0, 3, true};
+// Walks that only need the texel they land in: 2 % of a step is far inside it.
+constexpr WalkParams kLandingWalk{2e-2, 1.0, 2, true};
 
 bool walk_cached(const SubdivSurface& surface, const TexelFrames& frames, SurfacePoint& p,
-                 const Eigen::Vector3d& d) {
+                 const Eigen::Vector3d& d, bool landing_only) {
   return walk_surface([&](const SurfacePoint& q) { return frames.approx(q); },
-                      [&](int f, int e, double t) { return surface.cross_edge(f, e, t); }, p, d, kCachedWalk);
+                      [&](int f, int e, double t) { return surface.cross_edge(f, e, t); }, p, d,
+                      landing_only ? kLandingWalk : kCachedWalk);
 }
 
 void sample_points(const SubdivSurface& surface, const TexelFrames& frames, std::size_t t, double h, int r,
@@ -103,6 +111,34 @@ void sample_points(const SubdivSurface& surface, const TexelFrames& frames, std:
       valid[k] = (l == 0 && m == 0) ? true : walk_cached(surface, frames, p, double(l) * a - double(m) * b);
       out[k] = p;
     }
+}
+
+void march_points(const SubdivSurface& surface, const TexelFrames& frames, const SurfacePoint& c,
+                  const Eigen::Vector3d& a, const Eigen::Vector3d& b, int r, bool landing_only, SurfacePoint* out,
+                  bool* valid) {
+  const int side = 2 * r + 1;
+  auto march_row = [&](SurfacePoint start, bool ok, int m) {
+    out[(m + r) * side + r] = start;
+    valid[(m + r) * side + r] = ok;
+    for (int dir : {1, -1}) {
+      SurfacePoint q = start;
+      bool inside = ok;
+      for (int i = 1; i <= r; ++i) {
+        inside = walk_cached(surface, frames, q, double(dir) * a, landing_only) && inside;
+        out[(m + r) * side + r + dir * i] = q;
+        valid[(m + r) * side + r + dir * i] = inside;
+      }
+    }
+  };
+  march_row(c, true, 0);
+  for (int dir : {1, -1}) {
+    SurfacePoint start = c;
+    bool inside = true;
+    for (int m = 1; m <= r; ++m) {
+      inside = walk_cached(surface, frames, start, -double(dir) * b, landing_only) && inside;
+      march_row(start, inside, dir * m);
+    }
+  }
 }
 
 void sample_exemplar(const Image& ex, double x, double y, bool wrap, float* out) {

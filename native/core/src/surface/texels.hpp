@@ -48,9 +48,10 @@ struct TexelFrames {
 TexelFrames build_texel_frames(const SubdivSurface& surface, TexelGrid grid,
                                const std::vector<Eigen::Vector3f>& field, ExecContext* ctx);
 
-/// Walk with the texel cache (see SubdivSurface::walk).
+/// Walk with the texel cache (see SubdivSurface::walk). landing_only: a
+/// looser tolerance, for walks that only need the texel they end in.
 bool walk_cached(const SubdivSurface& surface, const TexelFrames& frames, SurfacePoint& p,
-                 const Eigen::Vector3d& d);
+                 const Eigen::Vector3d& d, bool landing_only = false);
 
 /// The (2r+1)^2 sample points around texel t at spacing h in its frame:
 /// sample (l, m) (l, m in [-r, r], row-major over m then l) is reached by
@@ -59,6 +60,19 @@ bool walk_cached(const SubdivSurface& surface, const TexelFrames& frames, Surfac
 /// false when the walk left the surface at a boundary.
 void sample_points(const SubdivSurface& surface, const TexelFrames& frames, std::size_t t, double h, int r,
                    SurfacePoint* out, bool* valid);
+
+/// Largest sample grid: 11 x 11.
+constexpr int kMaxSamples = 121;
+
+/// The same sample grid as sample_points around point c, for steps a = h v1
+/// and b = h v2, marched: each row starts one step from the previous row's
+/// start, each sample one step from its neighbour towards the centre column
+/// (the walk re-projects the step into each tangent plane). Walking every
+/// sample from the centre cost 2-3x more face crossings. A sample past a
+/// boundary (valid false) keeps the point where its walk stopped.
+void march_points(const SubdivSurface& surface, const TexelFrames& frames, const SurfacePoint& c,
+                  const Eigen::Vector3d& a, const Eigen::Vector3d& b, int r, bool landing_only, SurfacePoint* out,
+                  bool* valid);
 
 /// Bilinear exemplar lookup at float pixel (x, y): clamped or wrapped.
 void sample_exemplar(const Image& ex, double x, double y, bool wrap, float* out);
