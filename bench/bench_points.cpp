@@ -7,6 +7,7 @@
 
 #include <time.h>
 
+#include "cancel_latency.hpp"
 #include "exsynth/points.hpp"
 
 namespace {
@@ -31,13 +32,17 @@ const PointExemplar& exemplar_71k() {
   return ex;
 }
 
-void BM_PointsChainmail(benchmark::State& state) {
-  const PointExemplar& ex = exemplar_71k();
-  const double target = double(state.range(0));
-  // Output points per unit area: the exemplar's box density.
+// The side of the square that holds `target` output points at the
+// exemplar's box density (points per unit area).
+double side_for(const PointExemplar& ex, double target) {
   std::size_t inside = 0;
   for (const auto& p : ex.points.positions) inside += p.x() >= 0 && p.x() <= 1 && p.y() >= 0 && p.y() <= 1;
-  const double side = std::sqrt(target / double(inside));
+  return std::sqrt(target / double(inside));
+}
+
+void BM_PointsChainmail(benchmark::State& state) {
+  const PointExemplar& ex = exemplar_71k();
+  const double side = side_for(ex, double(state.range(0)));
   const PointTextureOptions opt = point_texture_preset("chainmail");
   PointTextureResult r;
   double cpu = 0;
@@ -57,5 +62,14 @@ void BM_PointsChainmail(benchmark::State& state) {
   state.counters["other_s"] = r.times.other;
 }
 BENCHMARK(BM_PointsChainmail)->Arg(197000)->Arg(2900000)->Iterations(1)->Unit(benchmark::kSecond)->UseRealTime();
+
+// Cancel latency per stage (cancel_latency.hpp) of the 197 k case.
+void BM_CancelLatencyPoints(benchmark::State& state) {
+  const PointExemplar& ex = exemplar_71k();
+  const double side = side_for(ex, 197000.0);
+  const PointTextureOptions opt = point_texture_preset("chainmail");
+  exsynth_bench::report(state, "points", [&](ExecContext* ctx) { synthesize_points(ex, side, side, opt, ctx); });
+}
+BENCHMARK(BM_CancelLatencyPoints)->Iterations(1)->Unit(benchmark::kSecond)->UseRealTime();
 
 }  // namespace

@@ -17,6 +17,7 @@
 
 #include "../tests/cpp/support/load_obj.hpp"
 #include "../tests/cpp/support/textures.hpp"
+#include "cancel_latency.hpp"
 #include "exsynth/surface.hpp"
 
 namespace {
@@ -124,8 +125,17 @@ void BM_SurfaceAtlasAndMesh(benchmark::State& state) {
   }
 }
 
+// Cancel latency per stage (cancel_latency.hpp): coherent synthesis on the cow
+// at ~100 k texels, 64^2 exemplar.
+void BM_CancelLatencySurface(benchmark::State& state) {
+  const exsynth::SurfaceSynthesisOptions o = options_for(double(state.range(0)), exsynth::SurfaceMethod::Coherent);
+  const exsynth::Image ex = exsynth::testing::disc_texture(64, 64, 3, 7, 64 * 64 / 60, 64.0f / 24);
+  exsynth_bench::report(state, "surface", [&](exsynth::ExecContext* ctx) { exsynth::synthesize_surface(cow(), ex, o, ctx); });
+}
+
 }  // namespace
 
+BENCHMARK(BM_CancelLatencySurface)->Arg(100000)->ArgName("texels")->Unit(benchmark::kSecond)->UseRealTime()->Iterations(1);
 BENCHMARK(BM_SurfaceCoherent)->Unit(benchmark::kSecond)->UseRealTime()->Iterations(1);
 BENCHMARK(BM_SurfaceMultiscale64)->Unit(benchmark::kSecond)->UseRealTime()->Iterations(1);
 BENCHMARK(BM_SurfaceMultiscale192)->Unit(benchmark::kSecond)->UseRealTime()->Iterations(1);

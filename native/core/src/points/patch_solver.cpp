@@ -39,10 +39,12 @@ void check_options(const PointTextureOptions& o) {
 }  // namespace
 
 void PatchSolver::sample_field(const PointSurface& surface, const std::vector<Eigen::Vector3f>& cells, float band,
-                               std::vector<float>& f, std::vector<Eigen::Vector3f>& n) {
+                               std::vector<float>& f, std::vector<Eigen::Vector3f>& n,
+                               const StageProgress* progress) {
   f.assign(cells.size(), band);
   n.assign(cells.size(), Eigen::Vector3f::Zero());
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, cells.size(), 256), [&](const auto& r) {
+    if (progress) progress->check();
     for (std::size_t i = r.begin(); i < r.end(); ++i) {
       const SurfaceSample s = surface.evaluate(cells[i]);
       if (!s.valid) continue;
@@ -59,9 +61,9 @@ PatchSolver::PatchSolver(const PointExemplar& exemplar, const PointTextureOption
   StageProgress progress(ctx, "exemplar field", 0.0, 0.05, 3);
   const auto& pos = exemplar.points.positions;
   const search::PointIndex index(pos);
-  spacing_ = mean_spacing(pos, index);
+  spacing_ = mean_spacing(pos, index, &progress);
   if (!(spacing_ > 0)) throw InvalidInput("the exemplar's points all coincide; give a point set with some extent");
-  sigma_ = surface_variation(pos, index);
+  sigma_ = surface_variation(pos, index, 12, &progress);
   progress.advance();
   patch_ = opt.patch_size;
   extra_ = opt.extra * patch_;
@@ -106,7 +108,7 @@ PatchSolver::PatchSolver(const PointExemplar& exemplar, const PointTextureOption
                             float(z0_ + (k + 0.5) * cell_));
   const PointSurface surface(pos, exemplar.points.normals, float(h_));
   progress.check();
-  sample_field(surface, cells, float(band_), ex_f_, ex_n_);
+  sample_field(surface, cells, float(band_), ex_f_, ex_n_, &progress);
   progress.advance();
   columns_.resize(std::size_t(gx_) * gy_);
   for (std::size_t p = 0; p < pos.size(); ++p) {

@@ -39,8 +39,10 @@ class PatchSolver {
 
   /// The metric's grid: signed distance and normal of `surface` at the cell
   /// centres `cells` (x, y, z each); f truncated to +-band, invalid -> +band.
+  /// `progress`, when given, is checked for a cancel per chunk of cells.
   static void sample_field(const PointSurface& surface, const std::vector<Eigen::Vector3f>& cells, float band,
-                           std::vector<float>& f, std::vector<Eigen::Vector3f>& n);
+                           std::vector<float>& f, std::vector<Eigen::Vector3f>& n,
+                           const StageProgress* progress = nullptr);
 
  private:
   struct Cell {

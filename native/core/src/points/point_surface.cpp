@@ -103,9 +103,10 @@ std::size_t PointSurface::nearest(const Eigen::Vector3f& x, float* d2) const {
 }
 
 std::vector<float> surface_variation(const std::vector<Eigen::Vector3f>& positions, const search::PointIndex& index,
-                                     int k) {
+                                     int k, const StageProgress* progress) {
   std::vector<float> out(positions.size(), 0.0f);
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, positions.size(), 1024), [&](const auto& r) {
+    if (progress) progress->check();
     std::vector<std::size_t> idx(k);
     std::vector<float> d2(k);
     for (std::size_t i = r.begin(); i < r.end(); ++i) {
@@ -127,11 +128,13 @@ std::vector<float> surface_variation(const std::vector<Eigen::Vector3f>& positio
   return out;
 }
 
-double mean_spacing(const std::vector<Eigen::Vector3f>& positions, const search::PointIndex& index) {
+double mean_spacing(const std::vector<Eigen::Vector3f>& positions, const search::PointIndex& index,
+                    const StageProgress* progress) {
   if (positions.size() < 2) return 0.0;
   // Per point, then summed in index order: the same value whatever the thread count.
   std::vector<double> nn(positions.size(), 0.0);
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, positions.size(), 4096), [&](const auto& r) {
+    if (progress) progress->check();
     std::size_t idx[2];
     float d2[2];
     for (std::size_t i = r.begin(); i < r.end(); ++i)

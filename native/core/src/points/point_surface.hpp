@@ -12,6 +12,7 @@
 
 #include <Eigen/Core>
 
+#include "exsynth/exec_context.hpp"
 #include "search/point_index.hpp"
 
 namespace exsynth::points {
@@ -66,9 +67,11 @@ class PointSurface {
 /// Surface variation sigma = l0 / (l0 + l1 + l2) of the k nearest points'
 /// covariance (Pauly et al.), per point; 0 on a plane, 1/3 isotropic.
 std::vector<float> surface_variation(const std::vector<Eigen::Vector3f>& positions, const search::PointIndex& index,
-                                     int k = 12);
+                                     int k = 12, const StageProgress* progress = nullptr);
 
 /// Mean distance from each point to its nearest other point.
-double mean_spacing(const std::vector<Eigen::Vector3f>& positions, const search::PointIndex& index);
+/// `progress`, when given, is checked for a cancel per chunk of points.
+double mean_spacing(const std::vector<Eigen::Vector3f>& positions, const search::PointIndex& index,
+                    const StageProgress* progress = nullptr);
 
 }  // namespace exsynth::points
