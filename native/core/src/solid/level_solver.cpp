@@ -20,11 +20,15 @@ LevelSolver::LevelSolver(Volume& texture, std::array<const ExemplarIndex*, 3> vi
       n_(opt.neighborhood), lo_(opt.neighborhood / 2), channel_lo_(std::move(channel_lo)),
       channel_hi_(std::move(channel_hi)) {
   const int dims[3] = {tex_.nx(), tex_.ny(), tex_.nz()};
-  // wrapped_[a][x + n] for x in [-n, dims[a] + n): wrapped, or clamped when not tileable.
+  // wrapped_[a][x + n] for x in [-n, dims[a] + n): wrapped, or clamped when
+  // not tileable; covered_ likewise, but -1 (no window) outside.
   for (int a = 0; a < 3; ++a) {
     wrapped_[a].resize(std::size_t(dims[a]) + 2 * n_);
-    for (int x = -n_; x < dims[a] + n_; ++x)
+    covered_[a].resize(std::size_t(dims[a]) + 2 * n_);
+    for (int x = -n_; x < dims[a] + n_; ++x) {
       wrapped_[a][x + n_] = wrap_ ? ((x % dims[a]) + dims[a]) % dims[a] : std::clamp(x, 0, dims[a] - 1);
+      covered_[a][x + n_] = wrap_ ? ((x % dims[a]) + dims[a]) % dims[a] : (x < 0 || x >= dims[a] ? -1 : x);
+    }
   }
   for (int i = 0; i < 3; ++i) {
     View& w = views_[i];
@@ -209,6 +213,16 @@ double LevelSolver::search(int iteration, bool exhaustive, StageProgress& progre
   return energy_count ? energy_sum / double(energy_count) : 0.0;
 }
 
+void LevelSolver::cover(const int p[3], const SliceAxes& s, Covering& c) const {
+  c.nu = c.nv = 0;
+  for (int d = 0; d < n_; ++d) {
+    const int su = covered_[s.u][p[s.u] - d + lo_ + n_];
+    if (su >= 0 && !(su & 1)) c.du[c.nu] = d, c.su[c.nu++] = su / 2;
+    const int sv = covered_[s.v][p[s.v] - d + lo_ + n_];
+    if (sv >= 0 && !(sv & 1)) c.dv[c.nv] = d, c.sv[c.nv++] = sv / 2;
+  }
+}
+
 void LevelSolver::optimize(int iteration, StageProgress& progress) {
   const bool collect = opt_.mean_shift;
   const int dims[3] = {tex_.nx(), tex_.ny(), tex_.nz()};
@@ -268,15 +282,8 @@ void LevelSolver::optimize(int iteration, StageProgress& progress) {
     }
   };
 
-  // wrapped[a][x + n] = x wrapped (or clamped away: -1) along axis a, for
-  // x in [-n, dims[a] + n); window_corner[i][j] = pixel index of window j's
-  // top-left texel in view i's exemplar.
-  std::array<std::vector<int>, 3> wrapped;
-  for (int a = 0; a < 3; ++a) {
-    wrapped[a].resize(std::size_t(dims[a]) + 2 * n_);
-    for (int x = -n_; x < dims[a] + n_; ++x)
-      wrapped[a][x + n_] = wrap_ ? ((x % dims[a]) + dims[a]) % dims[a] : (x < 0 || x >= dims[a] ? -1 : x);
-  }
+  // window_corner[i][j] = pixel index of window j's top-left texel in view
+  // i's exemplar.
   std::array<std::vector<std::int32_t>, 3> window_corner;
   for (int i = 0; i < 3; ++i) {
     const View& w = views_[i];
@@ -294,7 +301,7 @@ void LevelSolver::optimize(int iteration, StageProgress& progress) {
     parallel_chunks(g1 - g0, 1, progress, [&](std::size_t k0, std::size_t k1) {
       std::vector<float> values, weights;
       std::vector<float> acc(C_), mode(C_);
-      std::vector<int> du_list(n_), dv_list(n_), su_list(n_), sv_list(n_);
+      Covering cov(n_);
       for (std::size_t k = k0; k < k1; ++k) {
         std::vector<std::int64_t>& delta = deltas[k];
         if (hist) delta.assign(std::size_t(C_) * bins, 0);
@@ -313,26 +320,18 @@ void LevelSolver::optimize(int iteration, StageProgress& progress) {
                 if (!w.ex) continue;
                 const SliceAxes& s = kSlices[i];
                 const Image& img = w.ex->image();
-                // The sparse voxels whose windows cover p: offsets d with
-                // p - (d - lo) on the sparse grid (even), per slice axis.
-                int nu = 0, nv = 0;
-                for (int d = 0; d < n_; ++d) {
-                  const int su = wrapped[s.u][p[s.u] - d + lo_ + n_];
-                  if (su >= 0 && !(su & 1)) du_list[nu] = d, su_list[nu++] = su / 2;
-                  const int sv = wrapped[s.v][p[s.v] - d + lo_ + n_];
-                  if (sv >= 0 && !(sv & 1)) dv_list[nv] = d, sv_list[nv++] = sv / 2;
-                }
+                cover(p, s, cov);
                 const std::size_t slice = std::size_t(p[s.axis]) * w.nv;
                 const std::int32_t* corner = window_corner[i].data();
                 const float* fac = factor[i].data();
-                for (int a = 0; a < nv; ++a) {
-                  const std::size_t row = (slice + sv_list[a]) * w.nu;
-                  const std::size_t pix_dv = std::size_t(dv_list[a]) * img.width();
-                  for (int b = 0; b < nu; ++b) {
-                    const std::size_t sp = row + su_list[b];
+                for (int a = 0; a < cov.nv; ++a) {
+                  const std::size_t row = (slice + cov.sv[a]) * w.nu;
+                  const std::size_t pix_dv = std::size_t(cov.dv[a]) * img.width();
+                  for (int b = 0; b < cov.nu; ++b) {
+                    const std::size_t sp = row + cov.su[b];
                     const int j = w.match[sp];
                     if (j < 0) continue;
-                    const std::size_t pix = std::size_t(corner[j]) + pix_dv + du_list[b];
+                    const std::size_t pix = std::size_t(corner[j]) + pix_dv + cov.du[b];
                     const float wt = w.weight[sp] * fac[pix];
                     const float* e = img.data() + pix * C_;
                     for (int c = 0; c < C_; ++c) acc[c] += wt * e[c];
@@ -404,16 +403,10 @@ namespace exsynth::solid {
 // choice is independent of the others, so any thread count gives the same.
 void LevelSolver::discrete(StageProgress& progress, std::vector<std::int32_t>* source) {
   const int dims[3] = {tex_.nx(), tex_.ny(), tex_.nz()};
-  std::array<std::vector<int>, 3> wrapped;  // as in optimize(): -1 = outside (not tileable)
-  for (int a = 0; a < 3; ++a) {
-    wrapped[a].resize(std::size_t(dims[a]) + 2 * n_);
-    for (int x = -n_; x < dims[a] + n_; ++x)
-      wrapped[a][x + n_] = wrap_ ? ((x % dims[a]) + dims[a]) % dims[a] : (x < 0 || x >= dims[a] ? -1 : x);
-  }
   if (source) source->assign(tex_.voxel_count(), -1);
   // Rows of voxels (y, z) in parallel: an image is a single z-slice.
   parallel_chunks(std::size_t(dims[1]) * dims[2], 1, progress, [&](std::size_t r0, std::size_t r1) {
-    std::vector<int> du_list(n_), dv_list(n_), su_list(n_), sv_list(n_);
+    Covering cov(n_);
     for (std::size_t row = r0; row < r1; ++row) {
       const int y = int(row % std::size_t(dims[1])), z = int(row / std::size_t(dims[1]));
       for (int x = 0; x < dims[0]; ++x) {
@@ -428,25 +421,18 @@ void LevelSolver::discrete(StageProgress& progress, std::vector<std::int32_t>* s
           const int width = w.ex->image().width();
           float best_weight = -1.0f, support = 0.0f;
           std::size_t pix = 0;
-          // Windows covering p: sparse voxels at p - (d - lo) (even) per slice axis.
-          int nu = 0, nv = 0;
-          for (int d = 0; d < n_; ++d) {
-            const int su = wrapped[s.u][p[s.u] - d + lo_ + n_];
-            if (su >= 0 && !(su & 1)) du_list[nu] = d, su_list[nu++] = su / 2;
-            const int sv = wrapped[s.v][p[s.v] - d + lo_ + n_];
-            if (sv >= 0 && !(sv & 1)) dv_list[nv] = d, sv_list[nv++] = sv / 2;
-          }
-          for (int a = 0; a < nv; ++a) {
-            const std::size_t row_sp = (std::size_t(p[s.axis]) * w.nv + sv_list[a]) * w.nu;
-            for (int b = 0; b < nu; ++b) {
-              const std::size_t sp = row_sp + su_list[b];
+          cover(p, s, cov);
+          for (int a = 0; a < cov.nv; ++a) {
+            const std::size_t row_sp = (std::size_t(p[s.axis]) * w.nv + cov.sv[a]) * w.nu;
+            for (int b = 0; b < cov.nu; ++b) {
+              const std::size_t sp = row_sp + cov.su[b];
               const int j = w.match[sp];
               if (j < 0) continue;
               const float wt = w.weight[sp];
               support += wt;
               if (wt <= best_weight) continue;  // ties: the first in scan order
               best_weight = wt;
-              pix = std::size_t(w.ex->centre_v(j) - lo_ + dv_list[a]) * width + (w.ex->centre_u(j) - lo_ + du_list[b]);
+              pix = std::size_t(w.ex->centre_v(j) - lo_ + cov.dv[a]) * width + (w.ex->centre_u(j) - lo_ + cov.du[b]);
             }
           }
           if (best_weight >= 0.0f && support > best_support) best_support = support, best_view = i, best_pix = pix;

@@ -63,6 +63,16 @@ class LevelSolver {
 
   void gather(int i, std::size_t sparse, float* row) const;
 
+  // The sparse voxels whose windows cover voxel p in a slice of axes s: per
+  // slice axis, the offsets d (0..n-1) with p - (d - lo) on the sparse grid
+  // (even, inside the texture or wrapped) and that sparse coordinate.
+  struct Covering {
+    explicit Covering(int n) : du(n), su(n), dv(n), sv(n) {}
+    int nu = 0, nv = 0;
+    std::vector<int> du, su, dv, sv;
+  };
+  void cover(const int p[3], const SliceAxes& s, Covering& c) const;
+
   Volume& tex_;
   std::array<View, 3> views_;
   const Volume& constraint_;
@@ -72,6 +82,7 @@ class LevelSolver {
   int C_, n_, lo_;
   std::vector<float> channel_lo_, channel_hi_;
   std::array<std::vector<int>, 3> wrapped_;  // per axis: coordinate x + n -> wrapped/clamped x
+  std::array<std::vector<int>, 3> covered_;  // per axis: x + n -> wrapped x, or -1 outside when not tileable
 };
 
 }  // namespace exsynth::solid
