@@ -86,22 +86,11 @@ def run_solid(cow_path, exemplar_path, out_dir, size=64, samples=16):
     scene = bpy.context.scene
     view_layer = bpy.context.view_layer
 
-    # The OBJ importer turns the file's Y-up into Blender's Z-up (as the
-    # object's rotation: dimensions are right after a view-layer update).
-    bpy.ops.wm.obj_import(filepath=cow_path)
-    cow = view_layer.objects.active
-    cow.name = "Cow"
-    view_layer.update()
-    cow.scale = [COW_LENGTH / cow.dimensions.x] * 3
-    view_layer.update()
-    lo, hi = _world_bounds(cow)
-    cow.location -= Vector((0.5 * (lo[0] + hi[0]), 0.5 * (lo[1] + hi[1]), lo[2]))  # on the floor
+    cow, dims = _cow_on_the_floor(cow_path)
     _smooth(cow.data)
-    view_layer.update()
 
     # A box over the middle of the back, on the camera's side: the cut shows
     # the inside of the body.
-    dims = Vector(hi - lo)  # world extents (obj.dimensions ignores the importer's rotation)
     box = bpy.data.objects.new("Cut", mesh_io.new_mesh("Cut", *_box()))
     scene.collection.objects.link(box)
     box.location = (-0.03 * dims.x, -0.45 * dims.y, 0.72 * dims.z)
@@ -242,16 +231,7 @@ def run_surface(cow_path, wood_path, ground_path, out_dir, samples=16):
     _ensure_addon()
     scene = bpy.context.scene
     view_layer = bpy.context.view_layer
-    bpy.ops.wm.obj_import(filepath=cow_path)
-    cow = view_layer.objects.active
-    cow.name = "Cow"
-    view_layer.update()
-    cow.scale = [COW_LENGTH / cow.dimensions.x] * 3
-    view_layer.update()
-    lo, hi = _world_bounds(cow)
-    cow.location -= Vector((0.5 * (lo[0] + hi[0]), 0.5 * (lo[1] + hi[1]), lo[2]))
-    view_layer.update()
-    dims = Vector(hi - lo)
+    cow, dims = _cow_on_the_floor(cow_path)
 
     settings = scene.exsynth
     settings.surface_size_mode = 'DENSITY'
@@ -313,6 +293,25 @@ def _paint_strokes(bunny):
     paint[flank & (u[:, 0] > 0.6)] = (1.0, 0.0, 0.0)
     attribute = mesh.attributes.new("exsynth_paint", 'FLOAT_VECTOR', 'POINT')
     attribute.data.foreach_set("vector", paint.ravel())
+
+
+def _cow_on_the_floor(cow_path):
+    """The bundled cow imported as "Cow", COW_LENGTH long, centred on the
+    floor at the origin; returns it and its world extents (obj.dimensions
+    ignores the importer's rotation). The OBJ importer turns the file's Y-up
+    into Blender's Z-up as the object's rotation: dimensions are right after
+    a view-layer update."""
+    view_layer = bpy.context.view_layer
+    bpy.ops.wm.obj_import(filepath=cow_path)
+    cow = view_layer.objects.active
+    cow.name = "Cow"
+    view_layer.update()
+    cow.scale = [COW_LENGTH / cow.dimensions.x] * 3
+    view_layer.update()
+    lo, hi = _world_bounds(cow)
+    cow.location -= Vector((0.5 * (lo[0] + hi[0]), 0.5 * (lo[1] + hi[1]), lo[2]))  # on the floor
+    view_layer.update()
+    return cow, Vector(hi - lo)
 
 
 def _world_bounds(obj):
