@@ -101,15 +101,19 @@ Volume to_volume(const py::handle& arg, const char* name, const GridTransform& x
   return v;
 }
 
-GridTransform to_transform(const py::handle& origin, double voxel_size) {
-  auto o = py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(origin);
+Eigen::Vector3d to_point(const py::handle& h, const char* name, const char* meaning) {
+  auto o = py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(h);
   if (!o || o.ndim() != 1 || o.shape(0) != 3)
-    throw InvalidInput("'origin' must be 3 numbers (the world position of voxel (0, 0, 0)'s centre)");
+    throw InvalidInput(std::string("'") + name + "' must be 3 numbers (" + meaning + ")");
+  const Eigen::Vector3d p(o.at(0), o.at(1), o.at(2));
+  if (!p.allFinite()) throw InvalidInput(std::string("'") + name + "' must be finite");
+  return p;
+}
+
+GridTransform to_transform(const py::handle& origin, double voxel_size) {
+  const Eigen::Vector3d o = to_point(origin, "origin", "the world position of voxel (0, 0, 0)'s centre");
   GridTransform t;
-  for (int k = 0; k < 3; ++k) {
-    t.origin[k] = o.at(k);
-    if (!std::isfinite(t.origin[k])) throw InvalidInput("'origin' must be finite");
-  }
+  for (int k = 0; k < 3; ++k) t.origin[k] = o[k];
   if (!std::isfinite(voxel_size) || voxel_size <= 0)
     throw InvalidInput("'voxel_size' must be a finite number > 0, got " + std::to_string(voxel_size));
   t.voxel_size = voxel_size;

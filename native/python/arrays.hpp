@@ -30,6 +30,9 @@ TriangleMesh to_mesh(const py::handle& vertices, const py::handle& faces);
 /// Lists and tuples are converted by NumPy (see array_arg).
 Volume to_volume(const py::handle& a, const char* name, const GridTransform& xform);
 
+/// 3 finite numbers; the message names the argument and says what it means.
+Eigen::Vector3d to_point(const py::handle& h, const char* name, const char* meaning);
+
 /// Origin (3 floats) and voxel size -> transform; checks finiteness, size > 0.
 GridTransform to_transform(const py::handle& origin, double voxel_size);
 /// The same with voxel_size a Python number (checked: finite, > 0).

@@ -54,6 +54,31 @@ positive outside (None if compute_sdf=False); origin (3,) float64, the centre of
 meshes still give a solid. Releases the GIL; reports to ctx; raises CancelledError.)doc");
 
   m.def(
+      "voxel_grid",
+      [](const Vec3Arg& lo, const Vec3Arg& hi, const IntArg& resolution, const RealArg& voxel_size,
+         const IntArg& padding, const py::kwargs& extra) {
+        reject_unknown(extra, "resolution, voxel_size, padding");
+        VoxelizeOptions opt;
+        opt.resolution = int_arg(resolution, "resolution", 1, kMaxVoxelResolution, "voxels along the longest axis");
+        opt.voxel_size = real_arg(voxel_size, "voxel_size", 0.0, kInf, Ends::Closed, "mesh units; 0 = use resolution");
+        opt.padding = int_arg(padding, "padding", 0, kMaxVoxelPadding, "voxels");
+        const VoxelGridSpec g = voxel_grid_spec(to_point(lo, "lo", "the bounding box's low corner"),
+                                                to_point(hi, "hi", "the bounding box's high corner"), opt);
+        py::dict out;
+        out["shape"] = py::make_tuple(g.nz, g.ny, g.nx);
+        out["origin"] = py::make_tuple(g.transform.origin[0], g.transform.origin[1], g.transform.origin[2]);
+        out["voxel_size"] = g.transform.voxel_size;
+        return out;
+      },
+      py::arg("lo"), py::arg("hi"), py::kw_only(), py::arg("resolution") = 128, py::arg("voxel_size") = 0.0,
+      py::arg("padding") = 2,
+      R"doc(The grid voxelize would make for a mesh whose bounding box is [lo, hi], without voxelizing.
+
+Returns {'shape': (Z, Y, X), 'origin': (x, y, z) of voxel [0, 0, 0]'s centre, 'voxel_size'}:
+the voxel is the longest side / resolution unless voxel_size > 0; padding empty voxels on
+every side. For estimates and for voxelizing several meshes at one voxel size.)doc");
+
+  m.def(
       "model_thickness",
       [](const ArrayArg& vertices, const ArrayArg& faces, const IntArg& resolution, const RealArg& percentile,
          const RealArg& pattern_per_thickness, const IntArg& memory_budget, const IntArg& seed,

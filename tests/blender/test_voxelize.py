@@ -116,3 +116,18 @@ def test_saved_file_caches_beside_the_blend_with_relative_paths(bunny, tmp_path)
     volume = bpy.data.objects["bunny_voxels"].data
     assert volume.filepath == "//exsynth_cache/bunny_voxels.vdb"
     assert (tmp_path / "exsynth_cache" / "bunny_voxels.vdb").is_file()
+
+
+def test_panel_grid_estimate_is_the_grid_voxelize_makes(bunny):
+    # The estimate reads the object's dimensions (rotation not included):
+    # unrotated, they are its world bounding box.
+    from exsynth.panels.main import _grid_estimate
+
+    bunny.rotation_euler = (0.0, 0.0, 0.0)
+    bpy.context.view_layer.update()
+    settings = bpy.context.scene.exsynth
+    settings.padding = 3
+    assert voxelize() == {'FINISHED'}
+    path = bpy.path.abspath(bpy.data.objects["bunny_voxels"].data.filepath)
+    z, y, x = _native.read_vdb(path)["grids"]["density"].shape
+    assert _grid_estimate(bunny, settings) == f"about {x} × {y} × {z} voxels"

@@ -9,6 +9,7 @@
 #include <cmath>
 #include <limits>
 #include <thread>
+#include <tuple>
 
 #include "exsynth/voxelize.hpp"
 #include "support/load_obj.hpp"
@@ -66,6 +67,24 @@ TEST(Voxelize, VoxelSizeOverridesResolution) {
   const VoxelGridSpec g = voxel_grid_spec(box({0, 0, 0}, {2, 1, 1}), opt);
   EXPECT_EQ(g.nx, 8);
   EXPECT_EQ(g.ny, 4);
+}
+
+TEST(Voxelize, GridFromBoundingBoxEqualsGridFromMesh) {
+  const TriangleMesh m = box({-0.3f, 0.1f, 2}, {1.7f, 0.4f, 2.9f});
+  for (const double voxel_size : {0.0, 0.07}) {
+    VoxelizeOptions opt;
+    opt.resolution = 37;
+    opt.padding = 4;
+    opt.voxel_size = voxel_size;
+    const VoxelGridSpec a = voxel_grid_spec(m, opt);
+    const VoxelGridSpec b = voxel_grid_spec(Eigen::Vector3d(-0.3f, 0.1f, 2), Eigen::Vector3d(1.7f, 0.4f, 2.9f), opt);
+    EXPECT_EQ(std::make_tuple(a.nx, a.ny, a.nz), std::make_tuple(b.nx, b.ny, b.nz));
+    EXPECT_EQ(a.transform.voxel_size, b.transform.voxel_size);
+    for (int k = 0; k < 3; ++k) EXPECT_EQ(a.transform.origin[k], b.transform.origin[k]);
+  }
+  VoxelizeOptions opt;
+  EXPECT_THROW(voxel_grid_spec(Eigen::Vector3d(1, 0, 0), Eigen::Vector3d(0, 1, 1), opt), InvalidInput);
+  EXPECT_THROW(voxel_grid_spec(Eigen::Vector3d(0, 0, 0), Eigen::Vector3d(0, 0, 0), opt), InvalidInput);
 }
 
 TEST(Voxelize, BoxVolumeIsNearlyExactWhenFacesCutVoxels) {

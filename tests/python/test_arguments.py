@@ -84,6 +84,8 @@ FUNCTIONS = {
         "spacing": ("real", 0, None), "jitter": ("real", 0, 0.25), "dilation": ("real", 0, None),
         "groove_direction": "str", "memory_budget": "budget"}),
     "min_texture_size": (call("min_texture_size"), {"levels": ("int", 1, 8), "neighborhood": ("int", 3, 32)}),
+    "voxel_grid": (call("voxel_grid", (0, 0, 0), (1, 2, 3)), {
+        "resolution": ("int", 1, 2 ** 14), "voxel_size": ("real", 0, None), "padding": ("int", 0, 1024)}),
     "analogy_padding": (call("analogy_padding"), {"fine_size": ("int", 3, 9), "coarse_size": ("int", 1, 7)}),
     "validate_mesh": (call("validate_mesh", VERTS, FACES), {"name": "str"}),
     "point_texture_preset": (call("point_texture_preset"), {"name": "str"}),

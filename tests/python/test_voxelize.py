@@ -28,6 +28,28 @@ def test_bunny_volume_and_layout(bunny):
     np.testing.assert_allclose(centre, (lo + hi) / 2, atol=1e-6)
 
 
+@pytest.mark.parametrize("options", [dict(resolution=40, padding=3), dict(voxel_size=0.013, padding=0)])
+def test_voxel_grid_is_the_grid_voxelize_makes(bunny, options):
+    verts, faces = bunny
+    res = _native.voxelize(verts, faces, compute_sdf=False, **options)
+    v32 = verts.astype(np.float32)  # the voxelizer's mesh holds float32 positions
+    grid = _native.voxel_grid(v32.min(0), v32.max(0), **options)
+    assert grid["shape"] == res["density"].shape
+    assert grid["voxel_size"] == res["voxel_size"]
+    assert grid["origin"] == tuple(res["origin"])
+
+
+@pytest.mark.parametrize("lo, hi, message", [
+    ((1, 0, 0), (0, 1, 1), "lo <= hi"),
+    ((0, 0, 0), (0, 0, 0), "zero size"),
+    ((0, 0), (1, 1, 1), "'lo' must be 3 numbers"),
+    ((0, 0, 0), (1, np.nan, 1), "'hi' must be finite"),
+])
+def test_voxel_grid_refuses_a_bad_box(lo, hi, message):
+    with pytest.raises(ValueError, match=message):
+        _native.voxel_grid(lo, hi)
+
+
 def test_float32_int64_inputs_give_the_same_result(bunny):
     verts, faces = bunny
     a = _native.voxelize(verts.astype(np.float32), faces.astype(np.int64), resolution=24)

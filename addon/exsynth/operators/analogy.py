@@ -71,13 +71,9 @@ def fitted_pattern_scale(vertices, triangles, resolution):
 
 
 def voxel_size_for(vertices, resolution):
-    """B's voxel: its longest bounding-box side / resolution (as the voxelizer
-    computes it, from float32 positions)."""
-    v = np.asarray(vertices, np.float32).astype(np.float64)
-    longest = float((v.max(axis=0) - v.min(axis=0)).max())
-    if not longest > 0:
-        raise ValueError("the mesh has zero size (all vertices at one point); give it some extent")
-    return longest / resolution
+    """B's voxel, as the voxelizer computes it from its bounding box."""
+    v = np.asarray(vertices, np.float32)
+    return _native.voxel_grid(v.min(axis=0), v.max(axis=0), resolution=resolution, padding=0)["voxel_size"]
 
 
 def _voxelize(role, vertices, triangles, **options):

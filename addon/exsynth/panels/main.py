@@ -1,9 +1,9 @@
 # SPDX-License-Identifier: GPL-3.0-or-later
 """The "ExSynth" tab in the 3D viewport's sidebar (N-panel)."""
 
-import math
-
 import bpy
+
+from .. import _native
 
 CATEGORY = "ExSynth"
 
@@ -89,13 +89,13 @@ class EXSYNTH_PT_voxelize_advanced(bpy.types.Panel):
 def _grid_estimate(obj, settings):
     # From the object's dimensions (scale included, rotation not), so the
     # artist sees the grid size before starting; the engine computes the real one.
-    dims = obj.dimensions
-    longest = max(dims)
-    if longest <= 0:
+    try:
+        grid = _native.voxel_grid((0, 0, 0), tuple(obj.dimensions), resolution=settings.resolution,
+                                  padding=settings.padding)
+    except ValueError:
         return "Empty bounding box"
-    h = longest / settings.resolution
-    n = [math.ceil(d / h) + 2 * settings.padding for d in dims]
-    return f"about {n[0]} × {n[1]} × {n[2]} voxels"
+    z, y, x = grid["shape"]
+    return f"about {x} × {y} × {z} voxels"
 
 
 CLASSES = (EXSYNTH_PT_voxelize, EXSYNTH_PT_voxelize_advanced)

@@ -42,6 +42,9 @@ struct VoxelGridSpec {
   GridTransform transform;
 };
 VoxelGridSpec voxel_grid_spec(const TriangleMesh& mesh, const VoxelizeOptions& opt);
+/// The same placement from a bounding box [lo, hi] alone (the add-on's grid
+/// estimates and voxel sizes, before any triangles are handed over).
+VoxelGridSpec voxel_grid_spec(const Eigen::Vector3d& lo, const Eigen::Vector3d& hi, const VoxelizeOptions& opt);
 
 VoxelizeResult voxelize(const TriangleMesh& mesh, const VoxelizeOptions& opt = {},
                         ExecContext* ctx = nullptr);

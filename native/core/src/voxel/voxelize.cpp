@@ -42,12 +42,18 @@ double estimate_bytes(const VoxelGridSpec& g, const TriangleMesh& mesh) {
 
 VoxelGridSpec voxel_grid_spec(const TriangleMesh& mesh, const VoxelizeOptions& opt) {
   validate_mesh(mesh, "mesh");
-  validate_options(opt);
   Eigen::Vector3d lo = mesh.vertices[0].cast<double>(), hi = lo;
   for (const auto& v : mesh.vertices) {
     lo = lo.cwiseMin(v.cast<double>());
     hi = hi.cwiseMax(v.cast<double>());
   }
+  return voxel_grid_spec(lo, hi, opt);
+}
+
+VoxelGridSpec voxel_grid_spec(const Eigen::Vector3d& lo, const Eigen::Vector3d& hi, const VoxelizeOptions& opt) {
+  validate_options(opt);
+  if (!lo.allFinite() || !hi.allFinite() || (hi - lo).minCoeff() < 0)
+    throw InvalidInput("the bounding box must be finite with lo <= hi on every axis");
   const Eigen::Vector3d extent = hi - lo;
   const double longest = extent.maxCoeff();
   if (!(longest > 0))
