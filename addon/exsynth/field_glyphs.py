@@ -51,19 +51,36 @@ def mean_edge_length(vertices, triangles):
     return float(np.mean(np.linalg.norm(e, axis=1)))
 
 
-def strokes(vertices, normals, field, indices, length, lift):
-    """Segments (2 k, 3) float32, tail then head for each drawn vertex, the
-    tail at the vertex lifted by `lift` along its normal (so the surface does
-    not hide it), the head `length` along the field. Undefined vectors are
-    left out (they are marked as singular instead)."""
+def drawable(field, indices):
+    """The indices whose vectors can be drawn (finite, unit-ish); the others
+    are marked as singular instead."""
     f = np.asarray(field, np.float64)[indices]
-    good = np.all(np.isfinite(f), axis=1) & (np.linalg.norm(f, axis=1) > 0.5)
-    idx = np.asarray(indices)[good]
+    good = np.all(np.isfinite(f), axis=1) & (np.linalg.norm(np.nan_to_num(f), axis=1) > 0.5)
+    return np.asarray(indices)[good]
+
+
+def strokes(vertices, normals, field, indices, length, lift):
+    """Segments (2 k, 3) float32, tail then head for each drawable vertex of
+    `indices`, the tail at the vertex lifted by `lift` along its normal (so
+    the surface does not hide it), the head `length` along the field."""
+    idx = drawable(field, indices)
     tail = np.asarray(vertices, np.float64)[idx] + lift * np.asarray(normals, np.float64)[idx]
-    head = tail + length * normalized(f[good])
+    head = tail + length * normalized(np.asarray(field, np.float64)[idx])
     seg = np.empty((2 * len(idx), 3), np.float32)
     seg[0::2], seg[1::2] = tail, head
     return seg
+
+
+def facing(points, normals, eye=None, toward_viewer=None):
+    """Which points face the viewer: the eye's position for a perspective
+    view, else the direction toward the viewer (orthographic), both in the
+    points' space. The depth test hides marks on the far side of a model,
+    except those just behind its silhouette, whose tangent strokes stick out
+    past the rim; this test leaves those out."""
+    p = np.asarray(points, np.float64).reshape(-1, 3)
+    n = np.asarray(normals, np.float64).reshape(-1, 3)
+    to_viewer = np.asarray(eye, np.float64) - p if eye is not None else np.asarray(toward_viewer, np.float64)
+    return np.sum(n * to_viewer, axis=-1) > 0
 
 
 def undefined_vertices(field):
@@ -125,18 +142,20 @@ def clash_edges(edges, field, min_dot=0.0):
 
 
 def singular_points(vertices, triangles, field, normals, lift, edges=None):
-    """(points (S, 3) float32 where the field is singular, clash points
-    (C, 3) float32 at the middle of clashing edges), lifted off the surface."""
+    """Where the field is singular, lifted off the surface: a dict of
+    'singular' (S, 3) float32 points at undefined and singular vertices,
+    'clashes' (C, 3) at the middle of clashing edges, and the surface
+    normals there ('singular_normals', 'clash_normals')."""
     v = np.asarray(vertices, np.float64)
     nrm = np.asarray(normals, np.float64)
-    bad_v = undefined_vertices(field)
-    pts = [v[bad_v] + lift * nrm[bad_v]]
     t = np.asarray(triangles, np.int64)
+    at = [undefined_vertices(field)]
+    clash = np.zeros((0, 2), np.int64)
     if len(t):
-        singular = np.nonzero(vertex_indices(t, field, nrm) != 0)[0]
-        pts.append(v[singular] + lift * nrm[singular])
+        at.append(np.nonzero(vertex_indices(t, field, nrm) != 0)[0])
         clash = clash_edges(mesh_edges(t) if edges is None else edges, field)
-        clash_pts = v[clash].mean(axis=1) + lift * nrm[clash].mean(axis=1)
-    else:
-        clash_pts = np.zeros((0, 3))
-    return np.concatenate(pts).astype(np.float32), clash_pts.astype(np.float32)
+    at = np.concatenate(at)
+    clash_normals = nrm[clash].mean(axis=1)
+    return {"singular": (v[at] + lift * nrm[at]).astype(np.float32), "singular_normals": nrm[at].astype(np.float32),
+            "clashes": (v[clash].mean(axis=1) + lift * clash_normals).astype(np.float32),
+            "clash_normals": clash_normals.astype(np.float32)}

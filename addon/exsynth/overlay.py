@@ -30,9 +30,11 @@ _handle = None
 stroking = False
 LIVE_SINGULARITY_LIMIT = 50000
 # What the last draw did (the GUI smoke test reads it): draws counted, stroke
-# vertices and singular points in the last one.
-stats = {"draws": 0, "vertices": 0, "singular": 0, "clashes": 0, "object": None}
-_cache = {"key": None, "geometry": None, "topology_key": None, "topology": None, "batches": None}
+# vertices, singular points and clashes in the last one's geometry, and the
+# stroke vertices on the side facing the view (the ones drawn).
+stats = {"draws": 0, "vertices": 0, "singular": 0, "clashes": 0, "shown_vertices": 0, "object": None}
+_cache = {"key": None, "geometry": None, "topology_key": None, "topology": None, "batches": None,
+          "facing": None, "visible": None}
 
 
 def enabled():
@@ -51,7 +53,7 @@ def disable():
     if _handle is not None:
         bpy.types.SpaceView3D.draw_handler_remove(_handle, 'WINDOW')
         _handle = None
-    _cache.update(key=None, geometry=None, topology_key=None, topology=None, batches=None)
+    _cache.update(key=None, geometry=None, topology_key=None, topology=None, batches=None, facing=None, visible=None)
     _tag_redraw()
 
 
@@ -125,15 +127,36 @@ def geometry(obj, settings):
     idx, spacing = topo["strokes"]
     lift = 0.05 * topo["edge"]
     out = {"segments": field_glyphs.strokes(co, topo["normals"], field, idx,
-                                            settings.field_overlay_length * spacing, lift)}
+                                            settings.field_overlay_length * spacing, lift),
+           "segment_normals": topo["normals"][field_glyphs.drawable(field, idx)]}
     deferred = stroking and len(co) > LIVE_SINGULARITY_LIMIT
     if settings.field_overlay_singularities and len(tris) and not deferred:
-        out["singular"], out["clashes"] = field_glyphs.singular_points(
-            co, tris, field, topo["normals"], lift, edges=topo["edges"])
+        out.update(field_glyphs.singular_points(co, tris, field, topo["normals"], lift, edges=topo["edges"]))
     else:
-        out["singular"], out["clashes"] = np.zeros((0, 3), np.float32), np.zeros((0, 3), np.float32)
-    _cache.update(key=key, geometry=out, batches=None)
+        none = np.zeros((0, 3), np.float32)
+        out.update(singular=none, singular_normals=none, clashes=none, clash_normals=none)
+    _cache.update(key=key, geometry=out, batches=None, facing=None)
     return out
+
+
+def visible(geo, obj, region_data):
+    """The part of `geo` on the side of the model facing the view (see
+    field_glyphs.facing), cached on which marks face it."""
+    to_object = obj.matrix_world.inverted()
+    view_to_world = region_data.view_matrix.inverted()
+    if region_data.is_perspective:
+        view = {"eye": np.array(to_object @ view_to_world.translation)}
+    else:  # the view's +Z, toward the viewer, as a direction in object space
+        view = {"toward_viewer": np.array(to_object.to_3x3() @ view_to_world.col[2].xyz)}
+    masks = (field_glyphs.facing(geo["segments"][0::2], geo["segment_normals"], **view),
+             field_glyphs.facing(geo["singular"], geo["singular_normals"], **view),
+             field_glyphs.facing(geo["clashes"], geo["clash_normals"], **view))
+    key = tuple(hash(m.tobytes()) for m in masks)
+    if key != _cache.get("facing"):
+        seg = geo["segments"].reshape(-1, 2, 3)[masks[0]].reshape(-1, 3)
+        _cache.update(facing=key, batches=None,
+                      visible={"segments": seg, "singular": geo["singular"][masks[1]], "clashes": geo["clashes"][masks[2]]})
+    return _cache["visible"]
 
 
 def _batches(geo):
@@ -165,10 +188,11 @@ def _draw():
         return
     obj = field_object(context)
     if obj is None:
-        stats.update(object=None, vertices=0, singular=0, clashes=0)
+        stats.update(object=None, vertices=0, singular=0, clashes=0, shown_vertices=0)
         return
     geo = geometry(obj, settings)
-    batches = _batches(geo)
+    shown = visible(geo, obj, context.region_data)
+    batches = _batches(shown)
     gpu.state.depth_test_set('LESS_EQUAL')
     gpu.state.blend_set('ALPHA')
     gpu.matrix.push()
@@ -194,7 +218,7 @@ def _draw():
         gpu.state.depth_test_set('NONE')
         gpu.state.blend_set('NONE')
     stats.update(draws=stats["draws"] + 1, vertices=len(geo["segments"]), singular=len(geo["singular"]),
-                 clashes=len(geo["clashes"]), object=obj.name)
+                 clashes=len(geo["clashes"]), shown_vertices=len(shown["segments"]), object=obj.name)
 
 
 @bpy.app.handlers.persistent

@@ -331,6 +331,7 @@ def paint_start():
     _in_viewport(lambda: bpy.ops.mesh.primitive_uv_sphere_add(segments=64, ring_count=32, radius=1.0))
     settings = bpy.context.scene.exsynth
     settings.field_mode, settings.field_preset, settings.field_axis = 'PRESET', 'ALONG_AXIS', 'Y'
+    settings.geo_show_pattern = False  # the picture shows the field, not Geometric Texture's pattern sphere
     check(bpy.ops.exsynth.direction_field() == {'FINISHED'}, "a preset field along Y to paint over")
     win, area, region = _viewport()
     area.spaces.active.show_region_ui = True

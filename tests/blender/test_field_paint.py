@@ -220,6 +220,30 @@ def test_overlay_toggle_adds_and_removes_the_draw_handler(sphere):
     assert not overlay.enabled()
 
 
+def test_overlay_draws_only_the_side_facing_the_view(sphere):
+    import math
+    from types import SimpleNamespace as NS
+
+    from mathutils import Euler, Matrix, Vector
+
+    settings = bpy.context.scene.exsynth
+    settings.field_preset, settings.field_axis = 'AROUND_AXIS', 'Z'
+    assert bpy.ops.exsynth.direction_field() == {'FINISHED'}
+    sphere.location, sphere.scale = (3.0, 0.0, 0.0), (1.0, 2.0, 0.5)  # the test runs in object space
+    bpy.context.view_layer.update()
+    geo = overlay.geometry(sphere, settings)
+    # A view from +X, 10 units from the sphere's centre, looking at it (a
+    # camera rotated (90°, 0, 90°) looks along -X).
+    view_to_world = Matrix.Translation(Vector((13.0, 0.0, 0.0))) @ Euler((math.pi / 2, 0.0, math.pi / 2)).to_matrix().to_4x4()
+    for perspective in (True, False):
+        shown = overlay.visible(geo, sphere, NS(view_matrix=view_to_world.inverted(), is_perspective=perspective))
+        tails = shown["segments"][0::2]
+        assert 0.3 * len(geo["segments"]) < len(shown["segments"]) < 0.7 * len(geo["segments"])
+        assert np.all(tails[:, 0] > -0.1)  # object space: the +X half, seen from +X
+        # Around Z the poles are singular: square to the view, most are left out.
+        assert len(geo["singular"]) >= 2 and len(shown["singular"]) <= len(geo["singular"]) // 2
+
+
 def test_overlay_geometry_follows_the_field_and_survives_odd_objects(sphere):
     settings = bpy.context.scene.exsynth
     ctx = bpy.context

@@ -226,6 +226,24 @@ def test_strokes_run_from_the_lifted_vertex_along_the_field():
     np.testing.assert_allclose(tails[:, 2], 0.01, atol=1e-7)
 
 
+def test_facing_keeps_the_marks_on_the_viewed_side_of_a_sphere():
+    rng = np.random.default_rng(3)
+    n = rng.normal(size=(400, 3))
+    n /= np.linalg.norm(n, axis=1, keepdims=True)
+    p = 2.0 * n  # a sphere of radius 2, outward normals
+    eye = np.array([0.0, 0.0, 10.0])
+    front = field_glyphs.facing(p, n, eye=eye)
+    # Brute force: a point is seen when the ray from the eye meets the sphere there first.
+    for i in range(len(p)):
+        d = (p[i] - eye) / np.linalg.norm(p[i] - eye)
+        b = np.dot(d, eye)
+        t_first = -b - np.sqrt(b * b - (np.dot(eye, eye) - 4.0))
+        assert front[i] == bool(np.isclose(t_first, np.linalg.norm(p[i] - eye), atol=1e-9)), i
+    ortho = field_glyphs.facing(p, n, toward_viewer=(0.0, 0.0, 1.0))
+    np.testing.assert_array_equal(ortho, n[:, 2] > 0)
+    assert field_glyphs.facing(np.zeros((0, 3)), np.zeros((0, 3)), eye=eye).shape == (0,)
+
+
 def test_vertex_indices_find_a_vortex_a_saddle_and_nothing_in_a_uniform_field():
     verts, tris = grid(20)
     normals = field_brush.vertex_normals(verts, tris)
@@ -266,7 +284,10 @@ def test_singular_points_mark_undefined_vertices_and_clashes():
     field = np.tile([1.0, 0.0, 0.0], (len(verts), 1))
     field[verts[:, 0] > 0.3] = (-1.0, 0.0, 0.0)  # head-on along a line: a clash, not a vortex
     field[0] = np.nan
-    singular, clashes = field_glyphs.singular_points(verts, tris, field, normals, lift=0.0)
+    marks = field_glyphs.singular_points(verts, tris, field, normals, lift=0.0)
+    singular, clashes = marks["singular"], marks["clashes"]
+    assert len(marks["singular_normals"]) == len(singular) and len(marks["clash_normals"]) == len(clashes)
+    np.testing.assert_allclose(marks["clash_normals"][:, 2], 1.0, atol=1e-6)  # the grid lies in z = 0
     assert any(np.allclose(p, verts[0]) for p in singular)
     assert len(clashes) > 0 and np.all(np.abs(clashes[:, 0] - 0.4) < 0.25)
     edges = field_glyphs.mesh_edges(tris)
