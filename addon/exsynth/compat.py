@@ -7,12 +7,19 @@ changed and where it was checked.
   dimension ('3D_UNIFORM_COLOR', '2D_UNIFORM_COLOR', '3D_POLYLINE_SMOOTH_COLOR');
   4.0 removed those names for dimension-free ones ('UNIFORM_COLOR',
   'POLYLINE_SMOOTH_COLOR') that serve 2D and 3D alike.
+- Sized points: 4.5 has a POINT_UNIFORM_COLOR shader with a `size`
+  uniform (its name is in 4.5.15's and 5.0.1's bpy binaries, not in
+  4.2.23's; the wheels cannot make shaders, so it was not drawn there);
+  before, the point size is GL state (`gpu.state.point_size_set`).
+- Wide lines: `gpu.state.line_width_set` above 1 is not honoured by every
+  backend; the POLYLINE shaders (3.x and later) draw width themselves.
 - Node trees of new materials and worlds (`use_nodes`, deprecated in 5.0).
 """
 
 import bpy
 
 NEW_SHADER_NAMES = bpy.app.version >= (4, 0, 0)
+POINT_SIZE_UNIFORM = bpy.app.version >= (4, 5, 0)
 
 
 def builtin_shader_name(name, dimensions=3):
@@ -28,6 +35,38 @@ def builtin_shader(name, dimensions=3):
     import gpu  # not importable in every context (no GPU in `blender -b`): import on use
 
     return gpu.shader.from_builtin(builtin_shader_name(name, dimensions))
+
+
+def point_shader():
+    """The built-in shader for points of one colour and a set size (see
+    set_point_size)."""
+    return builtin_shader('POINT_UNIFORM_COLOR' if POINT_SIZE_UNIFORM else 'UNIFORM_COLOR')
+
+
+def set_point_size(shader, size):
+    """Point size in pixels for point_shader(), after shader.bind(): a uniform
+    from 4.5 on, GL state before (reset it with gpu.state.point_size_set(1))."""
+    if POINT_SIZE_UNIFORM:
+        shader.uniform_float("size", size)
+    else:
+        import gpu
+
+        gpu.state.point_size_set(size)
+
+
+def line_shader():
+    """The built-in shader for lines of one colour and a width in pixels
+    (set_line_style), in 2D or 3D alike."""
+    return builtin_shader('POLYLINE_UNIFORM_COLOR')
+
+
+def set_line_style(shader, colour, width):
+    """Colour and width for line_shader(), after shader.bind()."""
+    import gpu
+
+    shader.uniform_float("viewportSize", gpu.state.viewport_get()[2:])
+    shader.uniform_float("lineWidth", width)
+    shader.uniform_float("color", colour)
 
 
 def ensure_node_tree(data):

@@ -164,7 +164,7 @@ def _batches(geo):
 
     if _cache["batches"] is None:
         lines = compat.builtin_shader('POLYLINE_SMOOTH_COLOR')
-        points = compat.builtin_shader('UNIFORM_COLOR')
+        points = compat.point_shader()
         seg = geo["segments"]
         colours = np.empty((len(seg), 4), np.float32)
         colours[0::2], colours[1::2] = TAIL_COLOUR, HEAD_COLOUR
@@ -204,13 +204,13 @@ def _draw():
             shader.uniform_float("viewportSize", gpu.state.viewport_get()[2:])
             shader.uniform_float("lineWidth", 2.0)
             batch.draw(shader)
-        gpu.state.point_size_set(7.0)
         for name, colour in (("clashes", CLASH_COLOUR), ("singular", SINGULAR_COLOUR)):
             shader, batch = batches[name]
             if batch is None:
                 continue
             shader.bind()
             shader.uniform_float("color", colour)
+            compat.set_point_size(shader, 7.0)
             batch.draw(shader)
     finally:
         gpu.matrix.pop()

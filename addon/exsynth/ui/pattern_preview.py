@@ -106,13 +106,12 @@ def _draw():
     import gpu
     from gpu_extras.batch import batch_for_shader
 
-    shader = compat.builtin_shader('UNIFORM_COLOR')
+    shader = compat.line_shader()
     batch = batch_for_shader(shader, 'LINES', {"pos": sphere_lines(info["centre"], 0.5 * info["size"])})
     gpu.state.blend_set('ALPHA')
-    gpu.state.line_width_set(2.0)
-    shader.uniform_float("color", COLOR)
+    shader.bind()
+    compat.set_line_style(shader, COLOR, 2.0)
     batch.draw(shader)
-    gpu.state.line_width_set(1.0)
     gpu.state.blend_set('NONE')
 
 
