@@ -32,7 +32,7 @@ def test_fit_to_model_is_the_default_and_thinner_than_the_old_half(cow):
     s = settings()
     assert s.geo_pattern_fit and s.geo_show_pattern
     scale, measure, longest = fitted(cow)
-    info = pattern_preview.pattern_for(bpy.context, cow)
+    info = pattern_preview.pattern_for(bpy.context, cow, wait=True)
     assert info["scale"] == pytest.approx(scale) and 0.1 < info["scale"] < 0.5
     assert info["size"] == pytest.approx(scale * longest)
     assert info["thickness"] == pytest.approx(measure["thickness"])
@@ -43,7 +43,7 @@ def test_the_operator_uses_the_shown_size(cow, capfd):
     s = settings()
     s.geo_resolution = RESOLUTION
     s.geo_preset = 'SPIKES'
-    shown = pattern_preview.pattern_for(bpy.context, cow)["scale"]
+    shown = pattern_preview.pattern_for(bpy.context, cow, wait=True)["scale"]
     assert bpy.ops.exsynth.geometric_texture() == {'FINISHED'}
     pair = int(re.search(r"pair (\d+)×\1×\1", capfd.readouterr().out).group(1))
     assert pair == analogy_ops.pair_resolution(RESOLUTION, shown)
@@ -54,19 +54,52 @@ def test_set_by_hand(cow):
     s = settings()
     s.geo_pattern_fit = False
     s.geo_pattern_scale = 0.3
-    info = pattern_preview.pattern_for(bpy.context, cow)
+    info = pattern_preview.pattern_for(bpy.context, cow, wait=True)
     _, _, longest = fitted(cow)
     assert info["scale"] == pytest.approx(0.3) and info["thickness"] is None
     assert info["size"] == pytest.approx(0.3 * longest)
 
 
 def test_follows_the_object_scale(cow):
-    before = pattern_preview.pattern_for(bpy.context, cow)
+    before = pattern_preview.pattern_for(bpy.context, cow, wait=True)
     cow.scale = (1.6, 1.6, 1.6)
     bpy.context.view_layer.update()
-    after = pattern_preview.pattern_for(bpy.context, cow)
+    after = pattern_preview.pattern_for(bpy.context, cow, wait=True)
     assert after["scale"] == pytest.approx(before["scale"], rel=0.05)  # a fraction of the longest side
     assert after["size"] == pytest.approx(2.0 * before["size"], rel=0.05)  # 0.8 -> 1.6
+
+
+def test_the_measure_runs_off_the_main_thread(cow, monkeypatch):
+    """The panel and the viewport get 'pending' at once while the thickness
+    is measured on a worker; a moved mesh keeps showing the last size."""
+    import threading
+
+    measure = analogy_ops.fitted_pattern_scale
+    gate, threads = threading.Event(), []
+
+    def gated(*args):
+        threads.append(threading.current_thread())
+        gate.wait(30)
+        return measure(*args)
+
+    monkeypatch.setattr(analogy_ops, "fitted_pattern_scale", gated)
+    pattern_preview.detach()  # forget earlier tests' cows
+    pattern_preview.attach()
+    first = pattern_preview.pattern_for(bpy.context, cow)
+    assert first == {"pending": True, "last": None}
+    assert pattern_preview.pattern_for(bpy.context, cow) == first  # still running: no second worker
+    gate.set()
+    info = pattern_preview.pattern_for(bpy.context, cow, wait=True)
+    assert "scale" in info and threads and threads[0] is not threading.main_thread() and len(threads) == 1
+    assert pattern_preview.pattern_for(bpy.context, cow) is info  # cached
+
+    gate.clear()
+    cow.location.x += 1.0
+    bpy.context.view_layer.update()
+    moved = pattern_preview.pattern_for(bpy.context, cow)
+    assert moved["pending"] and moved["last"] is info
+    gate.set()
+    assert pattern_preview.pattern_for(bpy.context, cow, wait=True)["scale"] == pytest.approx(info["scale"], rel=0.01)
 
 
 def test_fitted_scale_stays_in_the_pairs_range():
@@ -84,7 +117,7 @@ def test_fitted_scale_stays_in_the_pairs_range():
 def test_mesh_without_faces_shows_why():
     obj = add_faceless_mesh()
     bpy.context.view_layer.objects.active = obj
-    assert pattern_preview.pattern_for(bpy.context, obj) == {"error": "no faces"}
+    assert pattern_preview.pattern_for(bpy.context, obj, wait=True) == {"error": "no faces"}
     assert pattern_preview.pattern_for(bpy.context, None) is None
 
 

@@ -21,6 +21,9 @@ def _draw_pattern_size(context, layout, pattern):
     """The pattern's size in scene units (and the thickness it was fitted to)."""
     if pattern is None:
         return
+    if "pending" in pattern:
+        layout.label(text="Pattern: measuring the model…", icon='SPHERE')
+        return
     if "error" in pattern:
         layout.label(text=f"Pattern: {pattern['error']}", icon='ERROR')
         return

@@ -4,12 +4,17 @@
 
 With Fit to Model on, the size comes from the mesh's thickness
 (operators.analogy.fitted_pattern_scale, the same call the operator makes).
-The measure takes a fraction of a second, so it is kept per mesh state and
-redone only when the mesh, its transform, its modifiers or the resolution
-change; the draw callback reads the same cache.
+The measure takes 0.2–0.8 s on the bundled meshes, too long for a draw
+callback: moving the object redraws the viewport at every mouse step and
+each step is a new mesh state. So it runs on a worker thread (the engine
+releases the GIL; the thread touches no bpy data), one at a time; until it
+ends the panel says "measuring" and the sphere keeps the last size. A
+timer on the main thread redraws the viewport when a measure ends, and the
+redraw asks for the newest state, so a drag costs one measure at a time.
 """
 
 import math
+import threading
 
 import bpy
 import numpy as np
@@ -23,6 +28,7 @@ COLOR = (1.0, 0.55, 0.1, 0.9)
 SEGMENTS = 64
 _cache = {}
 _handle = None
+_worker = {"thread": None, "key": None, "last": None}  # the measure running; (object name, info) of the last done
 
 
 def _state_key(obj, resolution, fit, manual_scale):
@@ -38,10 +44,12 @@ def _state_key(obj, resolution, fit, manual_scale):
             resolution, fit, None if fit else manual_scale)
 
 
-def pattern_for(context, obj):
+def pattern_for(context, obj, wait=False):
     """{'scale', 'size', 'thickness', 'centre'} for `obj` with the scene's
     settings (size and thickness in world units; thickness None when set by
-    hand), or {'error': message}. None when obj is not a mesh."""
+    hand), {'error': message}, or {'pending': True, 'last': the previous
+    info or None} while the thickness is measured on a worker thread (wait:
+    block until it is). None when obj is not a mesh."""
     if obj is None or obj.type != 'MESH':
         return None
     settings = context.scene.exsynth
@@ -49,26 +57,70 @@ def pattern_for(context, obj):
     found = _cache.get(obj.name)
     if found is not None and found[0] == key:
         return found[1]
+    running = _worker["thread"]
+    if running is not None and running.is_alive():
+        if not wait:
+            return _pending(obj.name)
+        running.join()
+        return pattern_for(context, obj, wait)
     # The view layer's graph as it stands: drawing must not re-evaluate it.
     verts, tris = mesh_io.world_triangles([obj], context.view_layer.depsgraph)
+    if len(tris) == 0 or not settings.geo_pattern_fit:
+        _store(key, obj.name, _measure(verts, tris, settings.geo_resolution, None, settings.geo_pattern_scale))
+        return _cache[obj.name][1]
+    name, resolution = obj.name, settings.geo_resolution  # read here: the thread must not touch bpy
+    thread = threading.Thread(target=lambda: _store(key, name, _measure(verts, tris, resolution, True)),
+                              name="exsynth pattern size", daemon=True)
+    _worker.update(thread=thread, key=key)
+    thread.start()
+    if wait:
+        thread.join()
+        return _cache[obj.name][1]
+    bpy.app.timers.register(_redraw_when_measured, first_interval=0.05)
+    return _pending(obj.name)
+
+
+def _pending(name):
+    last = _worker["last"]
+    return {"pending": True, "last": last[1] if last is not None and last[0] == name else None}
+
+
+def _measure(verts, tris, resolution, fit, manual_scale=None):
+    """The pattern info of a world-space mesh (no bpy: runs on the worker)."""
     if len(tris) == 0:
-        info = {"error": "no faces"}
-    else:
-        lo, hi = verts.min(axis=0), verts.max(axis=0)
-        longest = float((hi - lo).max())
-        info = {"centre": tuple(0.5 * (lo + hi)), "thickness": None}
-        try:
-            if settings.geo_pattern_fit:
-                info["scale"], measure = analogy_ops.fitted_pattern_scale(verts, tris, settings.geo_resolution)
-                info["thickness"] = measure["thickness"]
-            else:
-                info["scale"] = settings.geo_pattern_scale
-            info["size"] = info["scale"] * longest
-        except InputError as exc:
-            info = {"error": str(exc)}
-    _cache.clear()  # one mesh at a time: the active one
-    _cache[obj.name] = (key, info)
+        return {"error": "no faces"}
+    lo, hi = verts.min(axis=0), verts.max(axis=0)
+    longest = float((hi - lo).max())
+    info = {"centre": tuple(0.5 * (lo + hi)), "thickness": None}
+    try:
+        if fit:
+            info["scale"], measure = analogy_ops.fitted_pattern_scale(verts, tris, resolution)
+            info["thickness"] = measure["thickness"]
+        else:
+            info["scale"] = manual_scale
+        info["size"] = info["scale"] * longest
+    except InputError as exc:
+        info = {"error": str(exc)}
     return info
+
+
+def _store(key, name, info):
+    _cache.clear()  # one mesh at a time: the active one
+    _cache[name] = (key, info)
+    _worker["last"] = (name, info)
+
+
+def _redraw_when_measured():
+    """Timer (main thread): poll the worker; when it is done, redraw the 3D
+    views and the sidebar so they show the size (and ask for a newer state)."""
+    thread = _worker["thread"]
+    if thread is not None and thread.is_alive():
+        return 0.05
+    for window in getattr(bpy.context.window_manager, "windows", ()):
+        for area in window.screen.areas:
+            if area.type == 'VIEW_3D':
+                area.tag_redraw()
+    return None
 
 
 def length_text(context, value):
@@ -101,6 +153,8 @@ def _draw():
     if obj is None or obj.type != 'MESH' or context.mode != 'OBJECT':
         return
     info = pattern_for(context, obj)
+    if info and "pending" in info:
+        info = info["last"]
     if not info or "error" in info:
         return
     import gpu
@@ -127,3 +181,7 @@ def detach():
         bpy.types.SpaceView3D.draw_handler_remove(_handle, 'WINDOW')
         _handle = None
     _cache.clear()
+    thread = _worker["thread"]
+    if thread is not None:
+        thread.join()  # the add-on's module may go away with it
+    _worker.update(thread=None, key=None, last=None)
