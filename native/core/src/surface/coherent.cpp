@@ -3,6 +3,7 @@
 // candidates are the sources of already synthesized texels within the
 // neighbourhood radius, displaced by their tangent-plane offset.
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <deque>
 #include <limits>
@@ -79,9 +80,11 @@ struct NeighbourTable {
   int per = 0;
   std::vector<std::int32_t> texel;
   std::vector<Eigen::Vector2f> offset;
+  ChartStats stats;
 };
 
-NeighbourTable neighbour_table(const SubdivSurface& surface, const TexelFrames& fr, double h, int r, ExecContext* ctx) {
+NeighbourTable neighbour_table(const SubdivSurface& surface, const TexelFrames& fr, const VertexCharts* charts, double h,
+                               int r, ExecContext* ctx) {
   const int n = (2 * r + 1) * (2 * r + 1);
   NeighbourTable tab;
   tab.per = n - 1;
@@ -89,12 +92,14 @@ NeighbourTable neighbour_table(const SubdivSurface& surface, const TexelFrames& 
   tab.texel.resize(count * std::size_t(tab.per));
   tab.offset.resize(count * std::size_t(tab.per));
   StageProgress progress(ctx, "surface neighbourhoods", 0.0, 1.0, count);
+  std::atomic<std::uint64_t> in_chart{0}, walked{0};
   parallel_chunks(count, 1024, progress, [&](std::size_t b, std::size_t e) {
+    ChartStats stats;
     SurfacePoint pts[kMaxSamples];
     bool valid[kMaxSamples];
     for (std::size_t t = b; t < e; ++t) {
       const Eigen::Vector3d a = fr.t1[t].cast<double>(), bb = fr.t2[t].cast<double>();
-      march_points(surface, fr, fr.grid.centre(t), h * a, h * bb, r, true, pts, valid);
+      neighbourhood_points(surface, fr, charts, fr.grid.centre(t), t, h, r, pts, valid, &stats);
       std::size_t at = t * std::size_t(tab.per);
       for (int k = 0; k < n; ++k) {
         const int l = k % (2 * r + 1) - r, m = k / (2 * r + 1) - r;
@@ -112,7 +117,11 @@ NeighbourTable neighbour_table(const SubdivSurface& surface, const TexelFrames& 
         tab.offset[at++] = Eigen::Vector2f(float(l + to_centre.dot(a) / h), float(m - to_centre.dot(bb) / h));
       }
     }
+    in_chart += stats.in_chart;
+    walked += stats.walked;
   });
+  tab.stats.in_chart = in_chart;
+  tab.stats.walked = walked;
   return tab;
 }
 
@@ -220,11 +229,12 @@ std::vector<std::vector<std::size_t>> texel_waves(const TexelGrid& g, const std:
 
 }  // namespace
 
-void run_coherent(const SubdivSurface& surface, const TexelFrames& fr, const Image& ex,
+void run_coherent(const SubdivSurface& surface, const TexelFrames& fr, const VertexCharts* charts, const Image& ex,
                   const SurfaceSynthesisOptions& opt, SurfaceTexture& out, ExecContext* ctx) {
   const int C = ex.channels();
   const std::size_t count = fr.grid.size();
-  const NeighbourTable tab = neighbour_table(surface, fr, out.sample_spacing, opt.coherent_radius, ctx);
+  const NeighbourTable tab = neighbour_table(surface, fr, charts, out.sample_spacing, opt.coherent_radius, ctx);
+  add_stats(out, tab.stats);
   const std::vector<std::size_t> order = synthesis_order(surface, fr.grid);
   std::vector<char> done(count, 0);
   out.texels.assign(count * std::size_t(C), 0.0f);
