@@ -129,6 +129,9 @@ NeighbourTable neighbour_table(const SubdivSurface& surface, const TexelFrames& 
 
 namespace {
 
+/// Candidates closer than this (squared, exemplar pixels) count as one.
+constexpr double kSameCandidate2 = 0.25;
+
 /// The per-texel step of the coherent method over a built neighbour table.
 class CoherentSolver {
  public:
@@ -171,7 +174,7 @@ class CoherentSolver {
       Eigen::Vector2d c(out_.source[q * 2] - off[j].x(), out_.source[q * 2 + 1] - off[j].y());
       if (!inside(c)) continue;
       bool seen = false;
-      for (const auto& o : s.cands) seen = seen || (o - c).squaredNorm() < 0.0625;
+      for (const auto& o : s.cands) seen = seen || (o - c).squaredNorm() < kSameCandidate2;
       if (!seen) s.cands.push_back(c);
     }
     if (done_[t]) s.cands.emplace_back(out_.source[t * 2], out_.source[t * 2 + 1]);

@@ -142,6 +142,12 @@ void march_points(const SubdivSurface& surface, const TexelFrames& frames, const
   }
 }
 
+namespace {
+/// Chart units a neighbourhood may span (r (|tau_a| + |tau_b|)) before it is
+/// marched whole: the star face is about one unit, its ring reaches two.
+constexpr double kChartReach = 2.0;
+}  // namespace
+
 void chart_points(const SubdivSurface& surface, const TexelFrames& frames, const VertexCharts& charts,
                   const SurfacePoint& c, const Eigen::Vector3d& du, const Eigen::Vector3d& dv,
                   const Eigen::Vector3d& a, const Eigen::Vector3d& b, int r, bool landing_only, SurfacePoint* out,
@@ -161,7 +167,17 @@ void chart_points(const SubdivSurface& surface, const TexelFrames& frames, const
   const Eigen::Matrix2d to_param = gtg.inverse();
   const Eigen::Vector2d ta = jac * (to_param * (G.transpose() * a));
   const Eigen::Vector2d tb = jac * (to_param * (G.transpose() * b));
+  // A neighbourhood far larger than the star and its ring (coarse levels)
+  // is marched whole without trying the chart.
+  if (double(r) * (ta.norm() + tb.norm()) > kChartReach) {
+    march_points(surface, frames, c, a, b, r, landing_only, out, valid);
+    if (stats) stats->walked += std::uint64_t((2 * r + 1) * (2 * r + 1));
+    return;
+  }
   const int hint = charts.sector_of(chart, c.face);
+  SurfacePoint marched[kMaxSamples];
+  bool marched_valid[kMaxSamples];
+  bool have_march = false;
   int k = 0;
   std::uint64_t walked = 0;
   for (int m = -r; m <= r; ++m)
@@ -177,8 +193,13 @@ void chart_points(const SubdivSurface& surface, const TexelFrames& frames, const
         valid[k] = true;
         continue;
       }
-      valid[k] = walk_cached(surface, frames, p, double(l) * a - double(m) * b, landing_only);
-      out[k] = p;
+      // Past the chart: the marched sample (the whole neighbourhood marched once).
+      if (!have_march) {
+        march_points(surface, frames, c, a, b, r, landing_only, marched, marched_valid);
+        have_march = true;
+      }
+      out[k] = marched[k];
+      valid[k] = marched_valid[k];
       ++walked;
     }
   if (stats) {
