@@ -394,6 +394,12 @@ TEST(SurfaceCharts, StarsHaveTheValenceOfTheirCorner) {
     EXPECT_EQ(kinds[std::make_pair(4, false)], 4);
     EXPECT_EQ(kinds[std::make_pair(2, true)], 8);
     EXPECT_EQ(c.chart(0, 0), -1);
+    // Every star of this small grid has a face at a corner without a chart
+    // (the limit surface is not the regular layout there): none is used.
+    for (int i = 0; i < c.chart_count(); ++i) EXPECT_FALSE(c.used(i));
+    const SubdivSurface s6(flat_grid(6));
+    const surface::VertexCharts c6(s6);
+    EXPECT_GE(c6.chart(2 * 6 + 2, 2), 0);  // away from the corners
   }
 }
 

@@ -178,14 +178,14 @@ def test_multiscale_on_a_flat_plane_scores_near_the_2d_synthesis_and_coherence_h
     ex8 = (ex * 255).astype(np.uint8)
     got = {c: np.mean([nn_distance(assemble(_native.texture_surface(
         v, fs, fv, ex8, field=field, face_resolution=r, seed=seed, method="multiscale", coherence=c), n, r), ex)
-        for seed in (4, 5, 6)]) for c in (0.0, 1.0)}
+        for seed in (4, 5, 6, 7, 8)]) for c in (0.0, 1.0)}
     ref = nn_distance(_native.synthesize_image(ex8, width=n * r, height=n * r, seed=4)["image"], ex)
-    # Measured (mean of seeds 4-6): 0.45 with coherence (the default), 0.50
-    # without (Wei-Levoy's search alone); walking every sample instead of
-    # the vertex charts 0.43 / 0.48; the 2D synthesis 0.26. (One seed alone
-    # is too noisy: seed 4 gives 0.49 vs 0.51 with charts, 0.41 vs 0.48 without.)
+    # Measured (mean of seeds 4-8, 80 windows): 0.451 with coherence (the
+    # default), 0.474 without (Wei-Levoy's search alone); the 2D synthesis
+    # 0.26. (Since the coarsest level takes every exemplar pixel the gap is
+    # small; one seed alone is too noisy to show it.)
     assert got[1.0] < 1.9 * ref, f"multiscale {got[1.0]:.3f} vs 2D {ref:.3f}"
-    assert got[1.0] < 0.95 * got[0.0], f"with coherence {got[1.0]:.3f} vs without {got[0.0]:.3f}"
+    assert got[1.0] < 0.98 * got[0.0], f"with coherence {got[1.0]:.3f} vs without {got[0.0]:.3f}"
 
 
 def test_multiscale_and_channels():

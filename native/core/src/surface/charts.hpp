@@ -69,7 +69,13 @@ class VertexCharts {
   /// The chart of corner q (0..3 = (0,0), (1,0), (1,1), (0,1)) of a ptex
   /// face; -1 where the corner has none (valence 2 inside, one face on a
   /// boundary, T-junctions).
-  int chart(int face, int corner) const { return corner_chart_[std::size_t(face) * 4 + std::size_t(corner)]; }
+  int chart(int face, int corner) const {
+    const int c = corner_chart_[std::size_t(face) * 4 + std::size_t(corner)];
+    return c >= 0 && !charts_[std::size_t(c)].unused ? c : -1;
+  }
+  /// Stars with a face touching a corner without a chart (next to an open
+  /// mesh's corners) are built but not used (chart() gives -1 there).
+  bool used(int chart) const { return !charts_[std::size_t(chart)].unused; }
   /// The corner of (u, v)'s quarter of the face (the nearest in parameter).
   static int nearest_corner(double u, double v) { return u < 0.5 ? (v < 0.5 ? 0 : 3) : (v < 0.5 ? 1 : 2); }
   int chart_count() const { return int(charts_.size()); }
@@ -95,6 +101,7 @@ class VertexCharts {
   struct Star {
     int first = 0, k = 0;  // star_[first .. first + k): (face, corner) by sector
     bool boundary = false;
+    bool unused = false;   // see used()
     double opening = 0;    // sector angle
     const std::vector<SectorTable>* tables = nullptr;  // per sector (one shared when interior)
   };

@@ -295,6 +295,12 @@ class MultiscaleSolver {
     int margin = 0;
     if (!opt_.tileable_exemplar) {
       margin = std::max(lay.fine ? lay.fine_r : 0, lay.coarse ? 2 * lay.coarse_r + 1 : 0);
+      // The coarsest level (no coarser one) takes every pixel: on a 16^2
+      // level a 9x9 neighbourhood leaves (16 - 8)^2 = 64 whole ones, and so
+      // few candidates repeated themselves as long bands (the 64^2 wood on
+      // a flat grid: stripes 3-4 exemplars long; the multiscale cow's
+      // diagonal stripes). Flat-plane score unchanged (0.478 vs 0.480, 5 seeds).
+      if (!lay.coarse) margin = 0;
       margin = std::min(margin, (std::min(W, H) - 1) / 2);
     }
     ix->row.assign(std::size_t(W) * std::size_t(H), -1);
