@@ -1,7 +1,9 @@
 // Synthesis on subdivision surfaces: limit points against known surfaces and
 // the closed-form vertex limit, derivatives against finite differences,
 // ptex adjacency continuity, walks and neighbourhoods on flat surfaces (also
-// across extraordinary vertices) against plain 2D grids, coherent and
+// across extraordinary vertices) against plain 2D grids, vertex charts (stars
+// and valences, map/inverse identity, Jacobians against finite differences,
+// chart samples against exact walks), coherent and
 // multiscale synthesis (determinism across thread counts, coherence), the
 // atlas gutters and limit mesh, bad inputs.
 #include <gmock/gmock.h>
