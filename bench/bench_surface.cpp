@@ -89,8 +89,10 @@ class StageTimer {
   std::map<std::string, std::array<double, 2>> totals_;
 };
 
-void run(benchmark::State& state, const char* name, double texels, int exemplar, exsynth::SurfaceMethod method) {
-  const exsynth::SurfaceSynthesisOptions o = options_for(texels, method);
+void run(benchmark::State& state, const char* name, double texels, int exemplar, exsynth::SurfaceMethod method,
+         bool charts = true) {
+  exsynth::SurfaceSynthesisOptions o = options_for(texels, method);
+  o.vertex_charts = charts;
   const exsynth::Image ex = exsynth::testing::disc_texture(exemplar, exemplar, 3, 7, exemplar * exemplar / 60,
                                                            float(exemplar) / 24);
   std::size_t count = 0;
@@ -102,6 +104,7 @@ void run(benchmark::State& state, const char* name, double texels, int exemplar,
     state.counters["process_cpu_s"] = process_cpu_seconds() - cpu0;
     timer.finish(name);
     count = t.texel_count();
+    state.counters["walked_pct"] = 100.0 * double(t.walked_samples) / double(std::max<std::uint64_t>(1, t.chart_samples + t.walked_samples));
     benchmark::DoNotOptimize(t.texels.data());
   }
   state.counters["texels"] = double(count);
@@ -110,6 +113,8 @@ void run(benchmark::State& state, const char* name, double texels, int exemplar,
 }
 
 void BM_SurfaceCoherent(benchmark::State& state) { run(state, "coherent 96", 370e3, 96, exsynth::SurfaceMethod::Coherent); }
+// The same with every neighbourhood sample walked on the limit surface (no vertex charts).
+void BM_SurfaceCoherentWalks(benchmark::State& state) { run(state, "coherent 96, walks", 370e3, 96, exsynth::SurfaceMethod::Coherent, false); }
 void BM_SurfaceMultiscale64(benchmark::State& state) { run(state, "multiscale 64", 400e3, 64, exsynth::SurfaceMethod::Multiscale); }
 void BM_SurfaceMultiscale192(benchmark::State& state) { run(state, "multiscale 192", 400e3, 192, exsynth::SurfaceMethod::Multiscale); }
 
@@ -137,6 +142,7 @@ void BM_CancelLatencySurface(benchmark::State& state) {
 
 BENCHMARK(BM_CancelLatencySurface)->Arg(100000)->ArgName("texels")->Unit(benchmark::kSecond)->UseRealTime()->Iterations(1);
 BENCHMARK(BM_SurfaceCoherent)->Unit(benchmark::kSecond)->UseRealTime()->Iterations(1);
+BENCHMARK(BM_SurfaceCoherentWalks)->Unit(benchmark::kSecond)->UseRealTime()->Iterations(1);
 BENCHMARK(BM_SurfaceMultiscale64)->Unit(benchmark::kSecond)->UseRealTime()->Iterations(1);
 BENCHMARK(BM_SurfaceMultiscale192)->Unit(benchmark::kSecond)->UseRealTime()->Iterations(1);
 BENCHMARK(BM_SurfaceAtlasAndMesh)->Unit(benchmark::kSecond)->UseRealTime()->Iterations(1);

@@ -91,9 +91,9 @@ std::vector<Eigen::Vector3f> to_field(const py::handle& arg, std::size_t vertice
 }
 
 constexpr const char* kOptionNames =
-    "method, texels_per_unit, face_resolution, min_face_resolution, max_face_resolution, exemplar_scale, "
+    "method, texels_per_unit, face_resolution, (min|max)_face_resolution, exemplar_scale, "
     "coherent_radius, coherent_passes, levels, fine_neighborhood, coarse_neighborhood, knn, knn_tolerance, coherence, "
-    "pca_variance, max_pca_dims, tileable_exemplar, field_axis, memory_budget, seed, gutter, segments, "
+    "pca_variance, max_pca_dims, tileable_exemplar, vertex_charts, field_axis, memory_budget, seed, gutter, segments, "
     "displacement_(channel, scale, midlevel)";  // compact: the whole message stays under 400 characters
 
 // Per-face resolutions above this would not fit a memory budget anyway; the
@@ -126,6 +126,7 @@ void set_options(SurfaceSynthesisOptions& o, SurfaceOutputOptions& out, const py
     else if (k == "pca_variance") o.pca_variance = real_arg(v, k, 0.0, 1.0, Ends::OpenLow);
     else if (k == "max_pca_dims") o.max_pca_dims = int_arg(v, k, 1, 4096);
     else if (k == "tileable_exemplar") o.tileable_exemplar = bool_arg(v, k);
+    else if (k == "vertex_charts") o.vertex_charts = bool_arg(v, k);
     else if (k == "field_axis") {
       const char* expected = "3 finite numbers, not all zero";
       const py::array given = array_arg(v, k, expected);
@@ -188,6 +189,8 @@ void bind_surface(py::module_& m) {
         d["face_offset"] = take_vector(std::move(offset), {py::ssize_t(t.face_offset.size())});
         d["face_resolution"] = take_vector(std::move(t.face_resolution), {py::ssize_t(t.face_offset.size()) - 1});
         d["sample_spacing"] = t.sample_spacing;
+        d["chart_samples"] = t.chart_samples;
+        d["walked_samples"] = t.walked_samples;
         return d;
       },
       py::arg("vertices"), py::arg("face_sizes"), py::arg("face_vertices"), py::arg("exemplar"), py::kw_only(),
@@ -202,11 +205,11 @@ Options (keywords): method='coherent'|'multiscale', texels_per_unit=0 (0 = face_
 face_resolution=16, min_face_resolution=2, max_face_resolution=512, exemplar_scale=1,
 coherent_radius=2, coherent_passes=2, levels=0 (auto), fine_neighborhood=9, coarse_neighborhood=5, knn=4,
 knn_tolerance=0, coherence=1.0, pca_variance=0.97, max_pca_dims=24, tileable_exemplar=False,
-field_axis=(0, 0, 1), memory_budget=0 (default), seed=0; output: gutter=2, segments=2 (per n-gon
+vertex_charts=True (False: walk every neighbourhood sample on the limit surface), field_axis=(0, 0, 1), memory_budget=0 (default), seed=0; output: gutter=2, segments=2 (per n-gon
 sub-face; quads get 2x), displacement_channel=-1, displacement_scale=0, displacement_midlevel=0.5.
 Returns {'atlas': (H, W, C) float32 (row 0 = top), 'vertices': (N, 3), 'normals': (N, 3),
 'quads': (Q, 4) int32, 'corner_uvs': (4 Q, 2) (origin bottom-left), 'texels': (T, C),
-'source': (T, 2), 'face_offset': (P + 1,), 'face_resolution': (P,), 'sample_spacing': float}.)doc");
+'source': (T, 2), 'face_offset': (P + 1,), 'face_resolution': (P,), 'sample_spacing': float, 'chart_samples' / 'walked_samples': int (neighbourhood samples placed through vertex charts / walked)}.)doc");
 
   m.def(
       "surface_limit_points",

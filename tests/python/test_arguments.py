@@ -110,8 +110,8 @@ FUNCTIONS = {
         "exemplar_scale": ("real", 0, None), "coherent_radius": ("int", 1, 5), "coherent_passes": ("int", 1, 8),
         "levels": ("int", 0, 6), "fine_neighborhood": ("int", 3, 11), "coarse_neighborhood": ("int", 1, 11),
         "knn": ("int", 1, 64), "knn_tolerance": ("real", 0, None), "coherence": ("real", 0, None), "pca_variance": ("real", 0, 1),
-        "max_pca_dims": ("int", 1, 4096), "tileable_exemplar": "bool", "memory_budget": "budget", "seed": "seed",
-        "gutter": ("int", 0, 16), "segments": ("int", 1, 64), "displacement_channel": ("int", -1, 15),
+        "max_pca_dims": ("int", 1, 4096), "tileable_exemplar": "bool", "vertex_charts": "bool",
+        "memory_budget": "budget", "seed": "seed", "gutter": ("int", 0, 16), "segments": ("int", 1, 64), "displacement_channel": ("int", -1, 15),
         "displacement_scale": ("real", None, None), "displacement_midlevel": ("real", None, None), "ctx": "ctx"}),
     "surface_texel_count": (call("surface_texel_count", QUAD_V, QUAD_SIZES, QUAD_FV, face_resolution=4), {
         "method": "str", "texels_per_unit": ("real", 0, None), "face_resolution": ("int", 1, 16384),

@@ -154,6 +154,11 @@ struct SurfaceSynthesisOptions {
   double pca_variance = 0.97;
   int max_pca_dims = 24;
   bool tileable_exemplar = false;   ///< wrap exemplar lookups (else clamp / reject)
+  /// Place neighbourhood samples through vertex charts (Ying et al. §4.2:
+  /// the chart of the nearest corner, its Jacobian, back to the face the
+  /// sample falls in), walking on the limit surface only where a
+  /// neighbourhood leaves its chart; false = walk every sample.
+  bool vertex_charts = true;
   /// Per-control-vertex tangent field (the mesh's exsynth_field or a preset);
   /// empty = smooth_surface_field(axis = field_axis).
   std::vector<Eigen::Vector3f> field;
@@ -170,6 +175,9 @@ struct SurfaceTexture {
   std::vector<float> texels;                 ///< texel (i, j) of face f: (face_offset[f] + j * R + i) * C
   std::vector<float> source;                 ///< exemplar (x, y) each texel came from, 2 per texel
   double sample_spacing = 0.0;               ///< surface length of one exemplar pixel
+  /// Neighbourhood samples placed through vertex charts, and walked on the
+  /// limit surface (where a neighbourhood left its chart, or without charts).
+  std::uint64_t chart_samples = 0, walked_samples = 0;
   std::size_t texel_count() const { return face_offset.empty() ? 0 : face_offset.back(); }
 };
 

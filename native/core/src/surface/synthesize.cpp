@@ -1,6 +1,7 @@
 // synthesize_surface: validation, texel budget, frames, then one method.
 #include <algorithm>
 #include <cmath>
+#include <memory>
 #include <numeric>
 #include <string>
 
@@ -118,10 +119,17 @@ SurfaceTexture synthesize_surface(const SubdivSurface& surface, const Image& exe
       opt.field.empty() ? smooth_surface_field(surface.control_mesh(), opt.field_axis, 50, ctx) : opt.field;
   if (ctx) ctx->set_stage("surface frames");
   const surface::TexelFrames frames = surface::build_texel_frames(surface, grid, field, ctx);
+  std::unique_ptr<surface::VertexCharts> charts;
+  if (opt.vertex_charts) {
+    StageProgress progress(ctx, "surface charts", 0.0, 1.0, 1);
+    charts = std::make_unique<surface::VertexCharts>(surface);
+    progress.advance();
+    progress.check();
+  }
   if (opt.method == SurfaceMethod::Coherent)
-    surface::run_coherent(surface, frames, exemplar, opt, out, ctx);
+    surface::run_coherent(surface, frames, charts.get(), exemplar, opt, out, ctx);
   else
-    surface::run_multiscale(surface, frames, exemplar, opt, out, ctx);
+    surface::run_multiscale(surface, frames, charts.get(), exemplar, opt, out, ctx);
   return out;
 }
 

@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "exsynth/parallel.hpp"
+#include "surface/charts.hpp"
 #include "surface/walk.hpp"
 
 namespace exsynth::surface {
@@ -138,6 +139,72 @@ void march_points(const SubdivSurface& surface, const TexelFrames& frames, const
       inside = walk_cached(surface, frames, start, -double(dir) * b, landing_only) && inside;
       march_row(start, inside, dir * m);
     }
+  }
+}
+
+namespace {
+/// Chart units a neighbourhood may span (r (|tau_a| + |tau_b|)) before it is
+/// marched whole: the star face is about one unit, its ring reaches two.
+constexpr double kChartReach = 2.0;
+}  // namespace
+
+void chart_points(const SubdivSurface& surface, const TexelFrames& frames, const VertexCharts& charts,
+                  const SurfacePoint& c, const Eigen::Vector3d& du, const Eigen::Vector3d& dv,
+                  const Eigen::Vector3d& a, const Eigen::Vector3d& b, int r, bool landing_only, SurfacePoint* out,
+                  bool* valid, ChartStats* stats) {
+  const int chart = charts.chart(c.face, VertexCharts::nearest_corner(c.u, c.v));
+  if (chart < 0) {
+    march_points(surface, frames, c, a, b, r, landing_only, out, valid);
+    if (stats) stats->walked += std::uint64_t((2 * r + 1) * (2 * r + 1));
+    return;
+  }
+  Eigen::Matrix2d jac;
+  const Eigen::Vector2d y0 = charts.to_chart(chart, c, &jac);
+  // Parameter steps of a and b (least squares [du dv] x = d), into the chart.
+  Eigen::Matrix<double, 3, 2> G;
+  G << du, dv;
+  const Eigen::Matrix2d gtg = G.transpose() * G;
+  const Eigen::Matrix2d to_param = gtg.inverse();
+  const Eigen::Vector2d ta = jac * (to_param * (G.transpose() * a));
+  const Eigen::Vector2d tb = jac * (to_param * (G.transpose() * b));
+  // A neighbourhood far larger than the star and its ring (coarse levels)
+  // is marched whole without trying the chart.
+  if (double(r) * (ta.norm() + tb.norm()) > kChartReach) {
+    march_points(surface, frames, c, a, b, r, landing_only, out, valid);
+    if (stats) stats->walked += std::uint64_t((2 * r + 1) * (2 * r + 1));
+    return;
+  }
+  const int hint = charts.sector_of(chart, c.face);
+  SurfacePoint marched[kMaxSamples];
+  bool marched_valid[kMaxSamples];
+  bool have_march = false;
+  int k = 0;
+  std::uint64_t walked = 0;
+  for (int m = -r; m <= r; ++m)
+    for (int l = -r; l <= r; ++l, ++k) {
+      if (l == 0 && m == 0) {
+        out[k] = c;
+        valid[k] = true;
+        continue;
+      }
+      SurfacePoint p = c;
+      if (charts.from_chart(chart, y0 + double(l) * ta - double(m) * tb, p, !landing_only, hint)) {
+        out[k] = p;
+        valid[k] = true;
+        continue;
+      }
+      // Past the chart: the marched sample (the whole neighbourhood marched once).
+      if (!have_march) {
+        march_points(surface, frames, c, a, b, r, landing_only, marched, marched_valid);
+        have_march = true;
+      }
+      out[k] = marched[k];
+      valid[k] = marched_valid[k];
+      ++walked;
+    }
+  if (stats) {
+    stats->walked += walked;
+    stats->in_chart += std::uint64_t(k) - walked;
   }
 }
 

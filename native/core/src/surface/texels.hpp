@@ -74,6 +74,22 @@ void march_points(const SubdivSurface& surface, const TexelFrames& frames, const
                   const Eigen::Vector3d& a, const Eigen::Vector3d& b, int r, bool landing_only, SurfacePoint* out,
                   bool* valid);
 
+class VertexCharts;
+struct ChartStats;
+
+/// The same sample grid as march_points, placed through a vertex chart
+/// (Ying et al. §4.2, steps 1-5): c goes into the chart of the corner of its
+/// face nearest to it, the steps a, b (3D, in c's tangent plane) become
+/// chart steps through the chart's Jacobian and the surface derivatives
+/// du, dv at c (least squares, as a walk's first step), and sample (l, m)
+/// at y + l tau_a - m tau_b is mapped back to the face it falls in. Samples
+/// where the chart ends (past its ring, a boundary, a T-junction; corners
+/// without a chart) are walked from c instead. stats (optional) counts both.
+void chart_points(const SubdivSurface& surface, const TexelFrames& frames, const VertexCharts& charts,
+                  const SurfacePoint& c, const Eigen::Vector3d& du, const Eigen::Vector3d& dv,
+                  const Eigen::Vector3d& a, const Eigen::Vector3d& b, int r, bool landing_only, SurfacePoint* out,
+                  bool* valid, ChartStats* stats = nullptr);
+
 /// Bilinear exemplar lookup at float pixel (x, y): clamped or wrapped.
 void sample_exemplar(const Image& ex, double x, double y, bool wrap, float* out);
 
