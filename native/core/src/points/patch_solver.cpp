@@ -315,8 +315,7 @@ void PatchSolver::blend(std::vector<LocalPoint>& fresh, std::vector<char>& keep_
   // in `iters` steps (each re-projects from where the point now is).
   auto pull = [&](LocalPoint& pt, float w, const PointSurface& surface) {
     if (w <= 0) return;
-    float d2 = 0;
-    if (surface.nearest(pt.p, &d2) >= surface.size() || d2 > max_move * max_move) return;  // nothing to meet
+    if (!surface.any_within(pt.p, max_move)) return;  // nothing to meet
     const float alpha = 1.0f - std::pow(1.0f - std::min(w, 0.999f), 1.0f / float(iters));
     const Eigen::Vector3f start = pt.p;
     thread_local PointSurface::Cursor cursor;  // one neighbour query for all the steps, mostly

@@ -18,6 +18,7 @@
 #include <Eigen/Geometry>
 
 #include "points/patch_solver.hpp"
+#include "search/point_grid.hpp"
 #include "points/sampling.hpp"
 
 namespace exsynth {
@@ -35,7 +36,7 @@ OrientedPoints relax(OrientedPoints pts, double spacing, int rounds, ExecContext
   if (pts.size() < 2 || rounds <= 0) return pts;
   {
     StageProgress progress(ctx, "relaxing the density", 0.9, 0.95, pts.size());
-    const search::PointIndex index(pts.positions);
+    const search::PointGrid index(pts.positions, float(0.5 * spacing));
     std::vector<char> drop(pts.size(), 0);
     const float r = float(0.5 * spacing);
     parallel_chunks(pts.size(), 4096, progress, [&](std::size_t b, std::size_t e) {
@@ -60,7 +61,7 @@ OrientedPoints relax(OrientedPoints pts, double spacing, int rounds, ExecContext
   StageProgress progress(ctx, "relaxing the density", 0.95, 1.0, pts.size() * std::size_t(rounds));
   const float r = float(1.5 * spacing);
   for (int round = 0; round < rounds; ++round) {
-    const search::PointIndex index(pts.positions);
+    const search::PointGrid index(pts.positions, r);
     std::vector<V3> next(pts.positions);
     parallel_chunks(pts.size(), 4096, progress, [&](std::size_t b, std::size_t e) {
       std::vector<std::pair<std::size_t, float>> near;
