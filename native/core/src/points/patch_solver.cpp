@@ -414,6 +414,7 @@ void PatchSolver::place(const Chart& chart, std::uint64_t patch_id, OutputStore&
   for (std::size_t c = 0; c < cells.size(); ++c) overlap[c] = {rel[c], f[c], n[c]};
   const std::size_t pick = choose(overlap, patch_id);
   t0 = lap(t0, stats_.times.search);
+  if (ctx_) ctx_->check();  // a curved target's patch took up to 0.24 s (cancel latency bench)
 
   std::vector<float> src_sigma;
   std::vector<LocalPoint> fresh = source_points(pick, src_sigma);
@@ -423,6 +424,7 @@ void PatchSolver::place(const Chart& chart, std::uint64_t patch_id, OutputStore&
     warp(fresh, src_sigma, old, old_sigma, covered);
   }
   t0 = lap(t0, stats_.times.warp);
+  if (ctx_) ctx_->check();
 
   std::vector<char> keep_new, old_moved, old_dead;
   blend(fresh, keep_new, old, old_moved, old_dead, covered, old_surface);
