@@ -15,6 +15,7 @@
 #include "points/point_surface.hpp"
 #include "points/sampling.hpp"
 #include "points/tps.hpp"
+#include "support/cancel.hpp"
 #include "support/shapes.hpp"
 
 using namespace exsynth;
@@ -415,4 +416,16 @@ TEST(PointsToMesh, ASphereComesBackAsItsSurface) {
   OrientedPoints bad = sphere;
   bad.normals.pop_back();
   EXPECT_THROW(points_to_mesh(bad), InvalidInput);
+}
+
+TEST(PointTextureOnMesh, EveryStageCancels) {
+  // A curved target's stages (the target's sampling included, which had no
+  // check before) each stop on a cancel made inside them.
+  const PointExemplar& ex = bumps_exemplar();
+  const TriangleMesh sphere = exsynth::testing::icosphere(0.5f, 2);  // ~3 exemplar areas: a lean test
+  std::vector<V3> around(sphere.vertices.size());
+  for (std::size_t i = 0; i < around.size(); ++i) around[i] = V3::UnitZ().cross(sphere.vertices[i]);
+  const PointTextureOptions o = small_options();
+  exsynth::testing::expect_every_stage_cancels(
+      [&](ExecContext* ctx) { synthesize_points_on_mesh(ex, sphere, around, 1.0, o, ctx); }, 4);
 }
