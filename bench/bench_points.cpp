@@ -7,7 +7,9 @@
 
 #include <time.h>
 
+#include "../tests/cpp/support/load_obj.hpp"
 #include "cancel_latency.hpp"
+#include "exsynth/field.hpp"
 #include "exsynth/points.hpp"
 
 namespace {
@@ -71,5 +73,22 @@ void BM_CancelLatencyPoints(benchmark::State& state) {
   exsynth_bench::report(state, "points", [&](ExecContext* ctx) { synthesize_points(ex, side, side, opt, ctx); });
 }
 BENCHMARK(BM_CancelLatencyPoints)->Iterations(1)->Unit(benchmark::kSecond)->UseRealTime();
+
+// Cancel latency per stage of a curved target: the bundled bunny scaled to 2
+// units, chainmail at 1500 points per unit area, 0.5 target units per
+// exemplar unit, the field around the bunny's vertical (Y) axis.
+void BM_CancelLatencyPointsOnMesh(benchmark::State& state) {
+  static const PointExemplar ex = make_point_exemplar("chainmail", 1500.0);
+  TriangleMesh bunny = exsynth::testing::load_obj(exsynth::testing::asset("meshes/bunny.obj"));
+  Eigen::Vector3f lo = bunny.vertices[0], hi = lo;
+  for (const auto& v : bunny.vertices) lo = lo.cwiseMin(v), hi = hi.cwiseMax(v);
+  for (auto& v : bunny.vertices) v *= 2.0f / (hi - lo).maxCoeff();
+  const std::vector<Eigen::Vector3f> field = preset_direction_field(bunny, FieldPreset::AroundAxis, Eigen::Vector3f::UnitY());
+  const PointTextureOptions opt = point_texture_preset("chainmail");
+  exsynth_bench::report(state, "points on a mesh", [&](ExecContext* ctx) {
+    synthesize_points_on_mesh(ex, bunny, field, 0.5, opt, ctx);
+  });
+}
+BENCHMARK(BM_CancelLatencyPointsOnMesh)->Iterations(1)->Unit(benchmark::kSecond)->UseRealTime();
 
 }  // namespace

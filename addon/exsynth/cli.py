@@ -863,10 +863,15 @@ def _points_parser(sub):
     out = p.add_mutually_exclusive_group(required=True)
     out.add_argument("--size", type=_finite, nargs=2, metavar=("W", "D"), help="output area, exemplar units")
     out.add_argument("--target", help="a mesh to cover (.obj, .ply, .stl; file coordinates)")
-    p.add_argument("--field-preset", choices=analogy_ops.FIELD_PRESETS[:2], default="around_axis",
-                   help="--target: the direction the texture's x axis follows (default around_axis)")
+    p.add_argument("--field-preset", choices=analogy_ops.FIELD_PRESETS, default="around_axis",
+                   help="--target: the direction the texture's x axis follows (default around_axis; the "
+                   "presets of 'run analogy')")
     p.add_argument("--axis", type=_finite, nargs=3, metavar=("X", "Y", "Z"), default=(0.0, 0.0, 1.0),
-                   help="--field-preset's axis (default 0 0 1)")
+                   help="around_axis / along_axis: the axis in the file's coordinates (default 0 0 1)")
+    p.add_argument("--curve", help="along_curve: the curve as a polyline, .obj (vertices joined by 'l' lines) "
+                   "or .npy (N by 3), in the target file's coordinates")
+    p.add_argument("--field", help="--target's own field: .npy, one direction per vertex (V by 3, e.g. from "
+                   "'run field'); wins over --field-preset")
     p.add_argument("--scale", type=_finite, default=0.0,
                    help="--target: target units per exemplar unit (default: 1/8 of the target's longest side)")
     p.add_argument("--patch-size", type=_finite, default=0.0, help="patch side, exemplar units (default: preset's)")
@@ -912,6 +917,18 @@ def _points_exemplar(args, points_ops):
     return exemplar, "default"
 
 
+def _points_field(path, vertices):
+    """--field for a points target: V by 3 directions (zero rows are left to the engine's projection)."""
+    vectors = _load_npy("--field", path).astype(np.float64)
+    _require(vectors.shape == vertices.shape,
+             f"--field: {path} is {vectors.shape}; --target has {len(vertices)} vertices: give "
+             f"({len(vertices)}, 3), one direction per vertex (e.g. './exsynth run field --mesh' on the same file)")
+    _require(bool(np.isfinite(vectors).all()), f"--field: {path} has NaN or infinite values; fix or regenerate it")
+    _require(bool((np.linalg.norm(vectors, axis=1) > 0).any()),
+             f"--field: {path} is zero everywhere, so it gives the texture no direction")
+    return np.ascontiguousarray(vectors)
+
+
 def _run_points(args):
     from .io import point_files
     from .operators import points as points_ops
@@ -930,6 +947,10 @@ def _run_points(args):
         options["patch_size"] = 0.35 * float(min(exemplar.box[1]))
     job = points_ops.PointTextureJob(exemplar=exemplar, options=options, make_mesh=bool(args.mesh_out),
                                      memory_budget=int(args.memory_budget * GIB), seed=args.seed)
+    _require(args.target or not (args.curve or args.field), "--curve and --field go with --target MESH")
+    _require(args.field_preset != "along_curve" or args.curve or args.field,
+             "--field-preset along_curve needs --curve CURVE.obj (or .npy)")
+    _require(not args.curve or args.field_preset == "along_curve", "--curve goes with --field-preset along_curve")
     if args.size:
         _require(min(args.size) > 0, f"--size must be two positive lengths (got {args.size[0]} {args.size[1]})")
         job.size = tuple(args.size)
@@ -939,7 +960,10 @@ def _run_points(args):
         _require(len(tris) > 0, f"--target: {path} has no faces to cover")
         _require(any(args.axis) and all(np.isfinite(args.axis)), "--axis must be a finite, non-zero direction")
         job.target = points_ops.Target(name=os.path.splitext(os.path.basename(path))[0], vertices=verts,
-                                       triangles=tris, preset=args.field_preset, axis=tuple(args.axis))
+                                       triangles=tris, preset=args.field_preset, axis=tuple(args.axis),
+                                       curve=_read_curve(args.curve) if args.curve else None)
+        if args.field:
+            job.target.field = _points_field(args.field, verts)
         longest = float((verts.max(0) - verts.min(0)).max())
         job.scale = args.scale if args.scale > 0 else longest / 8.0
     result, seconds = _run_job(job, "points")

@@ -179,3 +179,51 @@ def test_cli_bad_arguments(tmp_path, capsys):
                      "--out", str(tmp_path / "x.ply")]) == 1
     assert "lower the patch size" in capsys.readouterr().err
     assert not (tmp_path / "x.ply").exists()
+
+
+def test_cli_target_field_presets_curve_and_own_field(tmp_path, capsys):
+    # The presets of 'run analogy' (around_axis, along_axis, along_curve with
+    # --curve) and a per-vertex --field. The wrong-shape error names the
+    # target's vertex count, which the right-shape run then uses.
+    base = ["points", "--preset", "bumps", "--target", BUNNY_OBJ, "--density", "150", "--scale", "1.5",
+            "--patch-size", "0.6"]
+    curve = tmp_path / "curve.npy"
+    np.save(curve, np.array([[0.0, -1.0, 0.0], [0.0, 0.0, 0.5], [0.0, 1.0, 0.0]]))
+    out = tmp_path / "curve.ply"
+    assert cli.main(base + ["--field-preset", "along_curve", "--curve", str(curve), "--out", str(out)]) == 0
+    pos, nrm = point_files.read_points(str(out))
+    assert len(pos) > 1000 and np.allclose(np.linalg.norm(nrm, axis=1), 1.0, atol=1e-3)
+    bad = tmp_path / "bad.npy"
+    np.save(bad, np.ones((3, 3)))
+    capsys.readouterr()
+    assert cli.main(base + ["--field", str(bad), "--out", str(tmp_path / "bad.ply")]) == 2
+    err = capsys.readouterr().err
+    assert "--target has" in err and "one direction per vertex" in err, err
+    assert not (tmp_path / "bad.ply").exists()
+    count = int(err.split("--target has ")[1].split()[0])
+    field = tmp_path / "field.npy"
+    np.save(field, np.tile([1.0, 0.0, 0.0], (count, 1)))
+    out2 = tmp_path / "field.ply"
+    assert cli.main(base + ["--field", str(field), "--out", str(out2)]) == 0
+    assert len(point_files.read_points(str(out2))[0]) > 1000
+
+
+def test_cli_field_arguments_that_do_not_fit(tmp_path, capsys):
+    base = ["points", "--preset", "bumps", "--density", "150", "--out", str(tmp_path / "x.ply")]
+    curve = tmp_path / "curve.npy"
+    np.save(curve, np.zeros((2, 3)))
+    nan = tmp_path / "nan.npy"
+    np.save(nan, np.full((4, 3), np.nan))
+    cases = [
+        (["--target", BUNNY_OBJ, "--field-preset", "along_curve"], "needs --curve"),
+        (["--target", BUNNY_OBJ, "--curve", str(curve)], "--curve goes with --field-preset along_curve"),
+        (["--size", "1", "1", "--curve", str(curve), "--field-preset", "along_curve"], "go with --target"),
+        (["--size", "1", "1", "--field", str(nan)], "go with --target"),
+        (["--target", BUNNY_OBJ, "--field-preset", "along_curve", "--curve", str(tmp_path / "none.npy")], "--curve"),
+        (["--target", BUNNY_OBJ, "--field-preset", "sideways"], "invalid choice"),
+    ]
+    for extra, message in cases:
+        capsys.readouterr()
+        assert cli.main(base + extra) == 2, extra
+        assert message in capsys.readouterr().err, (extra, message)
+    assert not (tmp_path / "x.ply").exists()

@@ -315,8 +315,7 @@ void PatchSolver::blend(std::vector<LocalPoint>& fresh, std::vector<char>& keep_
   // in `iters` steps (each re-projects from where the point now is).
   auto pull = [&](LocalPoint& pt, float w, const PointSurface& surface) {
     if (w <= 0) return;
-    float d2 = 0;
-    if (surface.nearest(pt.p, &d2) >= surface.size() || d2 > max_move * max_move) return;  // nothing to meet
+    if (!surface.any_within(pt.p, max_move)) return;  // nothing to meet
     const float alpha = 1.0f - std::pow(1.0f - std::min(w, 0.999f), 1.0f / float(iters));
     const Eigen::Vector3f start = pt.p;
     thread_local PointSurface::Cursor cursor;  // one neighbour query for all the steps, mostly
@@ -415,6 +414,7 @@ void PatchSolver::place(const Chart& chart, std::uint64_t patch_id, OutputStore&
   for (std::size_t c = 0; c < cells.size(); ++c) overlap[c] = {rel[c], f[c], n[c]};
   const std::size_t pick = choose(overlap, patch_id);
   t0 = lap(t0, stats_.times.search);
+  if (ctx_) ctx_->check();  // a curved target's patch took up to 0.24 s (cancel latency bench)
 
   std::vector<float> src_sigma;
   std::vector<LocalPoint> fresh = source_points(pick, src_sigma);
@@ -424,6 +424,7 @@ void PatchSolver::place(const Chart& chart, std::uint64_t patch_id, OutputStore&
     warp(fresh, src_sigma, old, old_sigma, covered);
   }
   t0 = lap(t0, stats_.times.warp);
+  if (ctx_) ctx_->check();
 
   std::vector<char> keep_new, old_moved, old_dead;
   blend(fresh, keep_new, old, old_moved, old_dead, covered, old_surface);

@@ -12,12 +12,12 @@ namespace exsynth::points {
 
 PointSurface::PointSurface(const std::vector<Eigen::Vector3f>& positions, const std::vector<Eigen::Vector3f>& normals,
                            float h)
-    : positions_(positions), normals_(normals), h_(h), index_(positions) {}
+    : positions_(positions), normals_(normals), h_(h), grid_(positions, kCutoff * h) {}
 
 SurfaceSample PointSurface::evaluate(const Eigen::Vector3f& x) const {
   if (positions_.empty()) return {};
   thread_local std::vector<std::pair<std::size_t, float>> near;
-  index_.radius(x, kCutoff * h_, near);  // weights beyond 2.5 h are below 0.2 %
+  grid_.radius(x, kCutoff * h_, near);  // weights beyond 2.5 h are below 0.2 %
   return weighted(x, near);
 }
 
@@ -55,7 +55,7 @@ SurfaceSample PointSurface::evaluate(const Eigen::Vector3f& x, Cursor& c) const 
   const float slack = 0.5f * h_, cutoff2 = (kCutoff * h_) * (kCutoff * h_);
   if (!((x - c.centre).squaredNorm() <= slack * slack)) {
     c.centre = x;
-    index_.radius(c.centre, kCutoff * h_ + slack, c.wide);
+    grid_.radius(c.centre, kCutoff * h_ + slack, c.wide);
   }
   c.near.clear();
   for (const auto& [i, unused] : c.wide) {
@@ -95,11 +95,7 @@ Projection PointSurface::project(const Eigen::Vector3f& x0, int iterations, floa
 }
 
 std::size_t PointSurface::nearest(const Eigen::Vector3f& x, float* d2) const {
-  std::size_t idx = positions_.size();
-  float dd = 0;
-  if (index_.knn(x, 1, &idx, &dd) == 0) idx = positions_.size();
-  if (d2) *d2 = dd;
-  return idx;
+  return grid_.nearest(x, d2);
 }
 
 std::vector<float> surface_variation(const std::vector<Eigen::Vector3f>& positions, const search::PointIndex& index,

@@ -13,6 +13,7 @@
 #include <Eigen/Core>
 
 #include "exsynth/exec_context.hpp"
+#include "search/point_grid.hpp"
 #include "search/point_index.hpp"
 
 namespace exsynth::points {
@@ -50,7 +51,8 @@ class PointSurface {
   Projection project(const Eigen::Vector3f& x, int iterations = 8, float tol = 1e-5f, Cursor* cursor = nullptr) const;
   /// Nearest point's index (size() when empty) and squared distance.
   std::size_t nearest(const Eigen::Vector3f& x, float* d2 = nullptr) const;
-  const search::PointIndex& index() const { return index_; }
+  /// True when some point is within r of x.
+  bool any_within(const Eigen::Vector3f& x, float r) const { return grid_.any_within(x, r); }
   float bandwidth() const { return h_; }
   std::size_t size() const { return positions_.size(); }
 
@@ -61,7 +63,7 @@ class PointSurface {
   const std::vector<Eigen::Vector3f>& positions_;
   const std::vector<Eigen::Vector3f>& normals_;
   float h_;
-  search::PointIndex index_;
+  search::PointGrid grid_;  ///< cells of the cut-off radius (2.5 h)
 };
 
 /// Surface variation sigma = l0 / (l0 + l1 + l2) of the k nearest points'

@@ -18,6 +18,7 @@
 #include <Eigen/Geometry>
 
 #include "points/patch_solver.hpp"
+#include "search/point_grid.hpp"
 #include "points/sampling.hpp"
 
 namespace exsynth {
@@ -35,7 +36,9 @@ OrientedPoints relax(OrientedPoints pts, double spacing, int rounds, ExecContext
   if (pts.size() < 2 || rounds <= 0) return pts;
   {
     StageProgress progress(ctx, "relaxing the density", 0.9, 0.95, pts.size());
-    const search::PointIndex index(pts.positions);
+    // Cells of 1.5 spacings, as the rounds below: cells of the query radius
+    // (half a spacing) held about one point each and their table cost 130 MB at 2.9 M points.
+    const search::PointGrid index(pts.positions, float(1.5 * spacing));
     std::vector<char> drop(pts.size(), 0);
     const float r = float(0.5 * spacing);
     parallel_chunks(pts.size(), 4096, progress, [&](std::size_t b, std::size_t e) {
@@ -60,7 +63,7 @@ OrientedPoints relax(OrientedPoints pts, double spacing, int rounds, ExecContext
   StageProgress progress(ctx, "relaxing the density", 0.95, 1.0, pts.size() * std::size_t(rounds));
   const float r = float(1.5 * spacing);
   for (int round = 0; round < rounds; ++round) {
-    const search::PointIndex index(pts.positions);
+    const search::PointGrid index(pts.positions, r);
     std::vector<V3> next(pts.positions);
     parallel_chunks(pts.size(), 4096, progress, [&](std::size_t b, std::size_t e) {
       std::vector<std::pair<std::size_t, float>> near;
@@ -163,11 +166,13 @@ namespace {
 // Patch centres on the target: Poisson-disk picks from its samples (index
 // order, radius r), visited outward from the first along a k-nearest graph
 // (Dijkstra), so each patch overlaps patches already placed, as scan lines do on a plane.
-std::vector<V3> patch_centres(const std::vector<V3>& samples, float r) {
+std::vector<V3> patch_centres(const std::vector<V3>& samples, float r, const StageProgress& progress) {
   points::OutputStore picked(r);
   std::vector<std::uint32_t> near;
   std::vector<V3> centres;
-  for (const V3& p : samples) {
+  for (std::size_t i = 0; i < samples.size(); ++i) {
+    progress.check_every(i);
+    const V3& p = samples[i];
     picked.gather(p, r, near);
     if (near.empty()) {
       picked.add(p, V3::UnitZ());
@@ -233,7 +238,13 @@ PointTextureResult synthesize_points_on_mesh(const PointExemplar& exemplar, cons
   // The target as a point-set surface, sampled a few times finer than the metric grid.
   const double cell_world = solver.patch() / opt.grid_resolution * scale;
   const std::size_t count = std::size_t(std::clamp(area / (cell_world * cell_world) * 2.0, 2000.0, 400000.0));
-  points::SurfaceSamples samples = points::sample_surface(target, count, opt.seed, nullptr);
+  // Sampling the target took 1.7 s without a cancel check (bunny, cancel
+  // latency bench): the sampler gets a context that only relays checks (its
+  // own stages and progress would overwrite this job's).
+  StageProgress prep(ctx, "sampling the target", 0.05, 0.05, 1);
+  ExecContext relay;
+  if (ctx) relay.on_check([ctx] { ctx->check(); });
+  points::SurfaceSamples samples = points::sample_surface(target, count, opt.seed, ctx ? &relay : nullptr);
   points::TargetSurface surface;
   surface.positions = std::move(samples.points.positions);
   surface.normals = std::move(samples.points.normals);
@@ -244,11 +255,12 @@ PointTextureResult synthesize_points_on_mesh(const PointExemplar& exemplar, cons
     surface.field[i] = w[0] * field[f[0]] + w[1] * field[f[1]] + w[2] * field[f[2]];
   }
   const search::PointIndex index(surface.positions);
-  const double target_spacing = points::mean_spacing(surface.positions, index);
+  const double target_spacing = points::mean_spacing(surface.positions, index, &prep);
   const float max_height = std::max(std::abs(solver.z_min()), std::abs(solver.z_max()));
   surface.surface = std::make_unique<points::PointSurface>(
       surface.positions, surface.normals, float(std::max(2.0 * target_spacing, 0.25 * max_height * scale)));
-  const std::vector<V3> centres = patch_centres(surface.positions, float(0.42 * solver.patch() * scale));
+  prep.check();
+  const std::vector<V3> centres = patch_centres(surface.positions, float(0.42 * solver.patch() * scale), prep);
   points::OutputStore out(float(0.5 * solver.patch() * scale));
   {
     StageProgress progress(ctx, "placing patches on the target", 0.05, 0.9, centres.size());
