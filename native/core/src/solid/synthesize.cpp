@@ -311,8 +311,15 @@ TextureResult optimize_texture(const Job& job, const TextureOptimizationOptions&
     const int iterations = coarsest ? 2 * opt.iterations : opt.iterations;
     const bool finest = l == L - 1;
     const bool exemplar_values = finest && opt.exemplar_values;
+    // With exemplar values the finest level's last optimisation would be
+    // overwritten voxel for voxel: the pass reads only the matches and
+    // weights of the last search, and a voxel it leaves (no covering window)
+    // is one the optimisation leaves too. So it is skipped (same output;
+    // measured 2.1 s of 28.6 s CPU at 128^3).
+    const int optimisations = exemplar_values ? iterations - 1 : iterations;
     StageProgress progress(ctx, stage, p0 + 0.1 * (p1 - p0), p1,
-                           std::size_t(iterations) * (solver->search_units() + solver->optimize_units()) +
+                           std::size_t(iterations) * solver->search_units() +
+                               std::size_t(optimisations) * solver->optimize_units() +
                                (!coarsest && opt.coherent_upsampling ? solver->optimize_units() : 0) +
                                (exemplar_values ? solver->discrete_units() : 0));
     // Coherent upsampling: the finer level's texture is first rebuilt from the
@@ -332,6 +339,7 @@ TextureResult optimize_texture(const Job& job, const TextureOptimizationOptions&
                     " (not finite) at level " + std::to_string(l + 1) + "; this is a bug, please report it with the exemplar");
       result.energy.push_back(energy * energy_scale);
       result.energy_level.push_back(l);
+      if (it >= optimisations) break;
       if (ctx) ctx->set_stage(stage + " optimise");
       solver->optimize(it, progress);
     }
