@@ -54,6 +54,11 @@ struct TextureOptimizationOptions {
   double ann_eps = 2.0;          ///< KdTree: nanoflann's eps (approximation tolerance)
   bool histogram_matching = true;
   int histogram_bins = 16;       ///< per channel
+  /// Exponent p of the histogram re-weighting: a texel whose bins the output
+  /// over-represents by `excess` counts (1 + excess)^-p. 1 = the gentle
+  /// weighting of before; 3 (measured, docs/solid.md) keeps the exemplar's
+  /// contrast: solids 0.68 -> 0.81, images 0.89 -> 0.95 over 8 exemplars.
+  double histogram_strength = 3.0;
   /// Finer levels start from the coarser level's matches applied to the finer
   /// exemplar (one optimisation pass before the first search) rather than
   /// from the trilinearly upsampled texture alone, which keeps the detail.

@@ -270,7 +270,11 @@ void LevelSolver::optimize(int iteration, StageProgress& progress) {
   for (std::size_t k = blocks; k > 1; --k) std::swap(order[k - 1], order[shuffle.below(k)]);
   const std::size_t groups = std::min<std::size_t>(blocks, 16);
 
-  // Per exemplar pixel: 1 / (1 + sum_c max(0, H_solid - H_exemplar)) at its bins.
+  // Per exemplar pixel: (1 + sum_c max(0, H_solid - H_exemplar))^-p at its bins.
+  // The excess sums over channels, so many channels would multiply the
+  // re-weighting: the exponent is as measured on RGB for up to 3 channels and
+  // scaled by 3 / C above (6 channels: half).
+  const double strength = C_ <= 3 || opt_.histogram_strength == 1.0 ? opt_.histogram_strength : opt_.histogram_strength * 3.0 / C_;
   std::array<std::vector<float>, 3> factor;
   auto update_factors = [&] {
     const double total = double(tex_.voxel_count());
@@ -286,7 +290,7 @@ void LevelSolver::optimize(int iteration, StageProgress& progress) {
           const std::size_t k = std::size_t(c) * bins + w.ex->bin(p, c);
           excess += std::max(0.0, counts[k] * bins / total - target[k]);
         }
-        factor[i][p] = float(1.0 / (1.0 + excess));
+        factor[i][p] = float(strength == 1.0 ? 1.0 / (1.0 + excess) : std::pow(1.0 + excess, -strength));
       }
     }
   };

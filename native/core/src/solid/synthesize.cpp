@@ -37,6 +37,7 @@ void check_options(const TextureOptimizationOptions& o) {
   range("random_candidates", o.random_candidates, 0, 64, "");
   range("ann_eps", o.ann_eps, 0, 1e6, "");
   range("histogram_bins", o.histogram_bins, 2, 256, "");
+  range("histogram_strength", o.histogram_strength, 0, 16, " (1 = the gentle weighting, 3 = default)");
   range("feature_weight", o.feature_weight, 0, 100, " (0 = off)");
   if (o.max_exemplar_size != 0) range("max_exemplar_size", o.max_exemplar_size, o.neighborhood, 1 << 16, " pixels (0 = full resolution)");
 }
