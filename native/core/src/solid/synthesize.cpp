@@ -29,6 +29,7 @@ void check_options(const TextureOptimizationOptions& o) {
   range("levels", o.levels, 1, 8, "");
   range("neighborhood", o.neighborhood, 3, 32, " (the paper uses 8)");
   range("iterations", o.iterations, 1, 100, "");
+  range("finest_iterations", o.finest_iterations, 0, 100, " (0 = iterations)");
   if (!(o.r > 0 && o.r <= 2)) throw InvalidInput("r must be in (0, 2], got " + std::to_string(o.r) + " (the paper uses 0.8)");
   if (!(o.pca_variance > 0 && o.pca_variance <= 1))
     throw InvalidInput("pca_variance must be in (0, 1], got " + std::to_string(o.pca_variance));
@@ -309,8 +310,12 @@ TextureResult optimize_texture(const Job& job, const TextureOptimizationOptions&
     const bool coarsest = l == 0;
     if (!coarsest) solver->inherit_matches(*previous);
 
-    const int iterations = coarsest ? 2 * opt.iterations : opt.iterations;
     const bool finest = l == L - 1;
+    // finest_iterations applies from two levels on (a single level is also
+    // the coarsest, which needs its 2x to converge).
+    const int iterations = coarsest ? 2 * opt.iterations
+                           : finest && opt.finest_iterations > 0 ? opt.finest_iterations
+                                                                 : opt.iterations;
     const bool exemplar_values = finest && opt.exemplar_values;
     // With exemplar values the finest level's last optimisation would be
     // overwritten voxel for voxel: the pass reads only the matches and
