@@ -55,6 +55,7 @@ void set_common(TextureOptimizationOptions& o, const py::kwargs& kw) {
     if (k == "levels") o.levels = int_arg(v, k, 1, 8);
     else if (k == "neighborhood") o.neighborhood = int_arg(v, k, 3, 32);
     else if (k == "iterations") o.iterations = int_arg(v, k, 1, 100);
+    else if (k == "finest_iterations") o.finest_iterations = int_arg(v, k, 0, 100);
     else if (k == "r") o.r = real_arg(v, k, 0.0, 2.0, Ends::OpenLow);
     else if (k == "pca_variance") o.pca_variance = real_arg(v, k, 0.0, 1.0, Ends::OpenLow);
     else if (k == "max_pca_dims") o.max_pca_dims = int_arg(v, k, 1, 4096);
@@ -64,6 +65,7 @@ void set_common(TextureOptimizationOptions& o, const py::kwargs& kw) {
     else if (k == "ann_eps") o.ann_eps = real_arg(v, k, 0.0, 1e6);
     else if (k == "histogram_matching") o.histogram_matching = bool_arg(v, k);
     else if (k == "histogram_bins") o.histogram_bins = int_arg(v, k, 2, 256);
+    else if (k == "histogram_strength") o.histogram_strength = real_arg(v, k, 0.0, 16.0);
     else if (k == "mean_shift") o.mean_shift = bool_arg(v, k);
     else if (k == "coherent_upsampling") o.coherent_upsampling = bool_arg(v, k);
     else if (k == "exemplar_values") o.exemplar_values = bool_arg(v, k);
@@ -74,8 +76,8 @@ void set_common(TextureOptimizationOptions& o, const py::kwargs& kw) {
     else if (k == "seed") o.seed = seed_arg(v, k);
     else
       throw InvalidInput("unknown option '" + k +
-                         "'; options: levels, neighborhood, iterations, r, pca_variance, max_pca_dims, search, "
-                         "coherence_k, random_candidates, ann_eps, histogram_matching, histogram_bins, mean_shift, coherent_upsampling, "
+                         "'; options: levels, neighborhood, iterations, finest_iterations, r, pca_variance, max_pca_dims, search, "
+                         "coherence_k, random_candidates, ann_eps, histogram_matching, histogram_bins, histogram_strength, mean_shift, coherent_upsampling, "
                          "exemplar_values, "
                          "feature_weight, tileable, max_exemplar_size, memory_budget, seed");
   }
@@ -160,8 +162,9 @@ exemplar: (H, W) or (H, W, C) uint8/uint16 (scaled to [0, 1]) or float; used for
 without its own. exemplar_y / exemplar_z: the y- and z-slice exemplars (same channels).
 views: active slices, 'xyz' or two of them. constraint: (size, size, size, C + 1) float32:
 target values then a weight in [0, 1]. Options (keywords): levels=3, neighborhood=8,
-iterations=3, r=0.8, pca_variance=0.95, max_pca_dims=32, search='kcoherence'|'kdtree'|'exact',
-coherence_k=4, random_candidates=2, ann_eps=2.0, histogram_matching=True, histogram_bins=16,
+iterations=3, finest_iterations=0 (rounds at the finest level; 0 = iterations), r=0.8, pca_variance=0.95, max_pca_dims=32,
+search='kcoherence'|'kdtree'|'exact', coherence_k=4, random_candidates=2, ann_eps=2.0, histogram_matching=True, histogram_bins=16, histogram_strength=3
+((1 + excess)^-strength re-weighting; 1 = gentle),
 mean_shift=False, coherent_upsampling=True, exemplar_values=True, feature_weight=0 (> 0: feature-distance channel), tileable=True,
 max_exemplar_size=256 (working resolution: larger exemplars are halved until they fit; 0 = never),
 memory_budget=0 (default), seed=0. size: min_texture_size(levels, neighborhood) .. SOLID_MAX_SIZE.

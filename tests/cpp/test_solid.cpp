@@ -6,6 +6,7 @@
 #include <tbb/global_control.h>
 
 #include <Eigen/Eigenvalues>
+#include <algorithm>
 #include <cmath>
 #include <utility>
 #include <limits>
@@ -209,6 +210,17 @@ TEST(Solid, PerViewExemplarsTwoViewsAndManyChannels) {
   const Volume baseline = shuffled(r.texture);
   EXPECT_LT(slice_to_exemplar_distance(r.texture, 0, ex.views[0]), 0.5 * slice_to_exemplar_distance(baseline, 0, ex.views[0]));
   EXPECT_LT(slice_to_exemplar_distance(r.texture, 2, ex.views[2]), 0.5 * slice_to_exemplar_distance(baseline, 2, ex.views[2]));
+}
+
+TEST(Solid, FinestIterationsSetsTheFinestLevelsRounds) {
+  SolidOptions o = small_options();  // 2 levels, 3 iterations: 6 coarsest rounds
+  o.finest_iterations = 2;
+  const TextureResult r = synthesize_solid(one_exemplar(disc_texture(32, 32, 3, 1)), o);
+  EXPECT_EQ(std::count(r.energy_level.begin(), r.energy_level.end(), 0), 6);
+  EXPECT_EQ(std::count(r.energy_level.begin(), r.energy_level.end(), 1), 2);
+  o.finest_iterations = 0;  // = iterations
+  const TextureResult d = synthesize_solid(one_exemplar(disc_texture(32, 32, 3, 1)), o);
+  EXPECT_EQ(std::count(d.energy_level.begin(), d.energy_level.end(), 1), 3);
 }
 
 TEST(Solid, FullWeightConstraintIsReproduced) {

@@ -12,6 +12,10 @@ ExemplarIndex::ExemplarIndex(const Image& image, int n, double pca_variance, int
                              int bins, const std::vector<float>& channel_lo, const std::vector<float>& channel_hi,
                              ExecContext* ctx, const std::string& stage, double lo, double hi, Coherence coherence)
     : image_(image), n_(n), vw_(image.width() - n + 1), vh_(image.height() - n + 1), bins_(bins) {
+  // Window centres as tables (n_ / 2 = lo(); the parameter lo shadows it).
+  centre_u_.resize(std::size_t(std::max(count(), 0)));
+  centre_v_.resize(centre_u_.size());
+  for (int j = 0; j < count(); ++j) centre_u_[std::size_t(j)] = n_ / 2 + j % vw_, centre_v_[std::size_t(j)] = n_ / 2 + j / vw_;
   // Shares of the stage's progress, roughly as the parts cost at 512^2 RGB.
   const double split = coherence_k > 0 ? lo + 0.35 * (hi - lo) : hi;
   const std::size_t rows = std::size_t(count());

@@ -38,8 +38,9 @@ class ExemplarIndex {
 
   /// Valid neighbourhood centres: index j <-> pixel (lo + j % vw, lo + j / vw).
   int count() const { return vw_ * vh_; }
-  int centre_u(int j) const { return lo() + j % vw_; }
-  int centre_v(int j) const { return lo() + j / vw_; }
+  // Tables, not j % vw: the search and optimisation ask millions of times.
+  int centre_u(int j) const { return centre_u_[std::size_t(j)]; }
+  int centre_v(int j) const { return centre_v_[std::size_t(j)]; }
   /// Index of the valid centre at (u, v), or -1 when its window leaves the image.
   int index_of(int u, int v) const {
     const int a = u - lo(), b = v - lo();
@@ -74,6 +75,7 @@ class ExemplarIndex {
 
   Image image_;
   int n_, vw_, vh_, k_ = 0, bins_;
+  std::vector<std::int32_t> centre_u_, centre_v_;
   RowMatrixXf neigh_, coeffs_;
   search::Pca pca_;
   std::vector<std::int32_t> similar_;

@@ -21,14 +21,25 @@ LevelSolver::LevelSolver(Volume& texture, std::array<const ExemplarIndex*, 3> vi
       channel_hi_(std::move(channel_hi)) {
   const int dims[3] = {tex_.nx(), tex_.ny(), tex_.nz()};
   // wrapped_[a][x + n] for x in [-n, dims[a] + n): wrapped, or clamped when
-  // not tileable; covered_ likewise, but -1 (no window) outside.
+  // not tileable. axis_cover_: for each coordinate, the window offsets d whose
+  // sparse voxel x - (d - lo) exists (wrapped, or inside when not tileable).
   for (int a = 0; a < 3; ++a) {
     wrapped_[a].resize(std::size_t(dims[a]) + 2 * n_);
-    covered_[a].resize(std::size_t(dims[a]) + 2 * n_);
-    for (int x = -n_; x < dims[a] + n_; ++x) {
+    for (int x = -n_; x < dims[a] + n_; ++x)
       wrapped_[a][x + n_] = wrap_ ? ((x % dims[a]) + dims[a]) % dims[a] : std::clamp(x, 0, dims[a] - 1);
-      covered_[a][x + n_] = wrap_ ? ((x % dims[a]) + dims[a]) % dims[a] : (x < 0 || x >= dims[a] ? -1 : x);
-    }
+    AxisCover& ac = axis_cover_[a];
+    ac.count.assign(std::size_t(dims[a]), 0);
+    ac.d.assign(std::size_t(dims[a]) * n_, 0);
+    ac.s.assign(std::size_t(dims[a]) * n_, 0);
+    for (int x = 0; x < dims[a]; ++x)
+      for (int d = 0; d < n_; ++d) {
+        const int y = x - d + lo_;
+        const int c = wrap_ ? ((y % dims[a]) + dims[a]) % dims[a] : (y < 0 || y >= dims[a] ? -1 : y);
+        if (c < 0 || (c & 1)) continue;
+        const std::size_t k = std::size_t(x) * n_ + std::size_t(ac.count[x]++);
+        ac.d[k] = d;
+        ac.s[k] = c / 2;
+      }
   }
   for (int i = 0; i < 3; ++i) {
     View& w = views_[i];
@@ -122,17 +133,55 @@ double LevelSolver::search(int iteration, bool exhaustive, StageProgress& progre
     parallel_chunks(batches, 1, progress, [&](std::size_t b0, std::size_t b1) {
       RowMatrixXf x(batch, D);
       std::vector<std::size_t> order(batch);
-      std::vector<int> cand;
       // stamp[j] = the last query that proposed candidate j: O(1) dedupe.
       // Coherent neighbours mostly propose the same candidates.
       std::vector<std::uint32_t> stamp(opt_.search == SolidSearch::KCoherence ? ex.count() : 0, 0);
       std::uint32_t query = 0;
+      // k-coherence: each sparse neighbour's match, shifted to this voxel,
+      // and that match's k most similar neighbourhoods, shifted likewise;
+      // plus a few random ones to escape local minima.
+      auto candidates = [&](std::size_t sp, std::vector<int>& cand) {
+        cand.clear();
+        ++query;  // stamps start at 0, queries at 1
+        const int a = int(sp / (std::size_t(w.nu) * w.nv)), sv = int((sp / w.nu) % w.nv), su = int(sp % w.nu);
+        for (int dv = -1; dv <= 1; ++dv)
+          for (int du = -1; du <= 1; ++du) {
+            int nu = su + du, nv = sv + dv;
+            if (wrap_) {
+              nu = (nu + w.nu) % w.nu;
+              nv = (nv + w.nv) % w.nv;
+            } else if (nu < 0 || nv < 0 || nu >= w.nu || nv >= w.nv) {
+              continue;
+            }
+            const int j = w.match[(std::size_t(a) * w.nv + nv) * w.nu + nu];
+            if (j < 0) continue;
+            auto add_shifted = [&](int jj) {
+              if (jj < 0) return;
+              const int c = ex.index_of(ex.centre_u(jj) - 2 * du, ex.centre_v(jj) - 2 * dv);
+              if (c >= 0 && stamp[c] != query) {
+                stamp[c] = query;
+                cand.push_back(c);
+              }
+            };
+            add_shifted(j);
+            const std::int32_t* sim = ex.similar(j);
+            for (int q = 0; q < ex.coherence_k(); ++q) add_shifted(sim[q]);
+          }
+        IndexRng rng(seed_, sp, std::uint64_t(iteration) * 3 + i);
+        for (int q = 0; q < opt_.random_candidates || cand.empty(); ++q) cand.push_back(int(rng.below(ex.count())));
+        // Candidates sit at scattered exemplar positions: request their first
+        // coefficients while the previous query is scored.
+        for (int c : cand) __builtin_prefetch(ex.coefficients().row(c).data());
+      };
+      std::vector<int> cand_of[2];
       for (std::size_t b = b0; b < b1; ++b) {
         const std::size_t first = b * batch, rows = std::min(batch, w.size() - first);
         for (std::size_t k = 0; k < rows; ++k) order[k] = sparse_of(first + k);
         for (std::size_t k = 0; k < rows; ++k) gather(i, order[k], x.row(Eigen::Index(k)).data());
         RowMatrixXf y;
         if (opt_.search != SolidSearch::Exact) y = ex.pca().project(x.topRows(Eigen::Index(rows)));
+        const bool coherence = opt_.search == SolidSearch::KCoherence && !exhaustive;
+        if (coherence) candidates(order[0], cand_of[0]);
         for (std::size_t k = 0; k < rows; ++k) {
           const std::size_t sp = order[k];
           int best = -1;
@@ -147,37 +196,10 @@ double LevelSolver::search(int iteration, bool exhaustive, StageProgress& progre
           } else if (exhaustive) {
             ((ex.coefficients().rowwise() - y.row(Eigen::Index(k))).rowwise().squaredNorm()).minCoeff(&best);
           } else {
-            // k-coherence: each sparse neighbour's match, shifted to this
-            // voxel, and that match's k most similar neighbourhoods, shifted
-            // likewise; plus a few random ones to escape local minima.
-            cand.clear();
-            ++query;  // stamps start at 0, queries at 1
-            const int a = int(sp / (std::size_t(w.nu) * w.nv)), sv = int((sp / w.nu) % w.nv), su = int(sp % w.nu);
-            for (int dv = -1; dv <= 1; ++dv)
-              for (int du = -1; du <= 1; ++du) {
-                int nu = su + du, nv = sv + dv;
-                if (wrap_) {
-                  nu = (nu + w.nu) % w.nu;
-                  nv = (nv + w.nv) % w.nv;
-                } else if (nu < 0 || nv < 0 || nu >= w.nu || nv >= w.nv) {
-                  continue;
-                }
-                const int j = w.match[(std::size_t(a) * w.nv + nv) * w.nu + nu];
-                if (j < 0) continue;
-                auto add_shifted = [&](int jj) {
-                  if (jj < 0) return;
-                  const int c = ex.index_of(ex.centre_u(jj) - 2 * du, ex.centre_v(jj) - 2 * dv);
-                  if (c >= 0 && stamp[c] != query) {
-                    stamp[c] = query;
-                    cand.push_back(c);
-                  }
-                };
-                add_shifted(j);
-                const std::int32_t* sim = ex.similar(j);
-                for (int q = 0; q < ex.coherence_k(); ++q) add_shifted(sim[q]);
-              }
-            IndexRng rng(seed_, sp, std::uint64_t(iteration) * 3 + i);
-            for (int q = 0; q < opt_.random_candidates || cand.empty(); ++q) cand.push_back(int(rng.below(ex.count())));
+            // The next query's candidates first (their loads overlap this
+            // query's scoring; reads only the previous round's matches).
+            if (k + 1 < rows) candidates(order[k + 1], cand_of[(k + 1) & 1]);
+            const std::vector<int>& cand = cand_of[k & 1];
             // Partial distances over 8-float blocks (the PCA space is padded
             // to a multiple of 8): most candidates lose within the first,
             // highest-variance dimensions, so stop as soon as they do.
@@ -185,9 +207,6 @@ double LevelSolver::search(int iteration, bool exhaustive, StageProgress& progre
             float bd = std::numeric_limits<float>::max();
             const int d = int(y.cols());
             const float* q = y.row(Eigen::Index(k)).data();
-            // Candidates sit at scattered exemplar positions: request their
-            // first coefficients up front so the cache misses overlap.
-            for (int c : cand) __builtin_prefetch(ex.coefficients().row(c).data());
             for (int c : cand) {
               const float* e = ex.coefficients().row(c).data();
               float acc = 0.0f;
@@ -211,16 +230,6 @@ double LevelSolver::search(int iteration, bool exhaustive, StageProgress& progre
     energy_count += energy.size();
   }
   return energy_count ? energy_sum / double(energy_count) : 0.0;
-}
-
-void LevelSolver::cover(const int p[3], const SliceAxes& s, Covering& c) const {
-  c.nu = c.nv = 0;
-  for (int d = 0; d < n_; ++d) {
-    const int su = covered_[s.u][p[s.u] - d + lo_ + n_];
-    if (su >= 0 && !(su & 1)) c.du[c.nu] = d, c.su[c.nu++] = su / 2;
-    const int sv = covered_[s.v][p[s.v] - d + lo_ + n_];
-    if (sv >= 0 && !(sv & 1)) c.dv[c.nv] = d, c.sv[c.nv++] = sv / 2;
-  }
 }
 
 void LevelSolver::optimize(int iteration, StageProgress& progress) {
@@ -261,7 +270,11 @@ void LevelSolver::optimize(int iteration, StageProgress& progress) {
   for (std::size_t k = blocks; k > 1; --k) std::swap(order[k - 1], order[shuffle.below(k)]);
   const std::size_t groups = std::min<std::size_t>(blocks, 16);
 
-  // Per exemplar pixel: 1 / (1 + sum_c max(0, H_solid - H_exemplar)) at its bins.
+  // Per exemplar pixel: (1 + sum_c max(0, H_solid - H_exemplar))^-p at its bins.
+  // The excess sums over channels, so many channels would multiply the
+  // re-weighting: the exponent is as measured on RGB for up to 3 channels and
+  // scaled by 3 / C above (6 channels: half).
+  const double strength = C_ <= 3 || opt_.histogram_strength == 1.0 ? opt_.histogram_strength : opt_.histogram_strength * 3.0 / C_;
   std::array<std::vector<float>, 3> factor;
   auto update_factors = [&] {
     const double total = double(tex_.voxel_count());
@@ -277,7 +290,7 @@ void LevelSolver::optimize(int iteration, StageProgress& progress) {
           const std::size_t k = std::size_t(c) * bins + w.ex->bin(p, c);
           excess += std::max(0.0, counts[k] * bins / total - target[k]);
         }
-        factor[i][p] = float(1.0 / (1.0 + excess));
+        factor[i][p] = float(strength == 1.0 ? 1.0 / (1.0 + excess) : std::pow(1.0 + excess, -strength));
       }
     }
   };
@@ -301,7 +314,6 @@ void LevelSolver::optimize(int iteration, StageProgress& progress) {
     parallel_chunks(g1 - g0, 1, progress, [&](std::size_t k0, std::size_t k1) {
       std::vector<float> values, weights;
       std::vector<float> acc(C_), mode(C_);
-      Covering cov(n_);
       for (std::size_t k = k0; k < k1; ++k) {
         std::vector<std::int64_t>& delta = deltas[k];
         if (hist) delta.assign(std::size_t(C_) * bins, 0);
@@ -320,7 +332,7 @@ void LevelSolver::optimize(int iteration, StageProgress& progress) {
                 if (!w.ex) continue;
                 const SliceAxes& s = kSlices[i];
                 const Image& img = w.ex->image();
-                cover(p, s, cov);
+                const Covering cov = cover(p, s);
                 const std::size_t slice = std::size_t(p[s.axis]) * w.nv;
                 const std::int32_t* corner = window_corner[i].data();
                 const float* fac = factor[i].data();
@@ -406,7 +418,6 @@ void LevelSolver::discrete(StageProgress& progress, std::vector<std::int32_t>* s
   if (source) source->assign(tex_.voxel_count(), -1);
   // Rows of voxels (y, z) in parallel: an image is a single z-slice.
   parallel_chunks(std::size_t(dims[1]) * dims[2], 1, progress, [&](std::size_t r0, std::size_t r1) {
-    Covering cov(n_);
     for (std::size_t row = r0; row < r1; ++row) {
       const int y = int(row % std::size_t(dims[1])), z = int(row / std::size_t(dims[1]));
       for (int x = 0; x < dims[0]; ++x) {
@@ -421,7 +432,7 @@ void LevelSolver::discrete(StageProgress& progress, std::vector<std::int32_t>* s
           const int width = w.ex->image().width();
           float best_weight = -1.0f, support = 0.0f;
           std::size_t pix = 0;
-          cover(p, s, cov);
+          const Covering cov = cover(p, s);
           for (int a = 0; a < cov.nv; ++a) {
             const std::size_t row_sp = (std::size_t(p[s.axis]) * w.nv + cov.sv[a]) * w.nu;
             for (int b = 0; b < cov.nu; ++b) {

@@ -65,13 +65,21 @@ class LevelSolver {
 
   // The sparse voxels whose windows cover voxel p in a slice of axes s: per
   // slice axis, the offsets d (0..n-1) with p - (d - lo) on the sparse grid
-  // (even, inside the texture or wrapped) and that sparse coordinate.
+  // (even, inside the texture or wrapped) and that sparse coordinate. They
+  // depend on one coordinate each, so they are tabulated per axis (axis_cover_).
   struct Covering {
-    explicit Covering(int n) : du(n), su(n), dv(n), sv(n) {}
     int nu = 0, nv = 0;
-    std::vector<int> du, su, dv, sv;
+    const int *du = nullptr, *su = nullptr, *dv = nullptr, *sv = nullptr;
   };
-  void cover(const int p[3], const SliceAxes& s, Covering& c) const;
+  Covering cover(const int p[3], const SliceAxes& s) const {
+    const std::size_t u = std::size_t(p[s.u]), v = std::size_t(p[s.v]);
+    const AxisCover &cu = axis_cover_[s.u], &cv = axis_cover_[s.v];
+    return {cu.count[u], cv.count[v], cu.d.data() + u * n_, cu.s.data() + u * n_, cv.d.data() + v * n_,
+            cv.s.data() + v * n_};
+  }
+  struct AxisCover {
+    std::vector<int> count, d, s;  // per coordinate x: count, then n slots of (d, sparse coordinate)
+  };
 
   Volume& tex_;
   std::array<View, 3> views_;
@@ -82,7 +90,7 @@ class LevelSolver {
   int C_, n_, lo_;
   std::vector<float> channel_lo_, channel_hi_;
   std::array<std::vector<int>, 3> wrapped_;  // per axis: coordinate x + n -> wrapped/clamped x
-  std::array<std::vector<int>, 3> covered_;  // per axis: x + n -> wrapped x, or -1 outside when not tileable
+  std::array<AxisCover, 3> axis_cover_;
 };
 
 }  // namespace exsynth::solid
