@@ -55,7 +55,7 @@ void set_common(TextureOptimizationOptions& o, const py::kwargs& kw) {
     if (k == "levels") o.levels = int_arg(v, k, 1, 8);
     else if (k == "neighborhood") o.neighborhood = int_arg(v, k, 3, 32);
     else if (k == "iterations") o.iterations = int_arg(v, k, 1, 100);
-    else if (k == "finest_iterations") o.finest_iterations = int_arg(v, k, 0, 100);
+    else if (k == "finest_iterations") o.finest_iterations = int_arg(v, k, -1, 100);
     else if (k == "r") o.r = real_arg(v, k, 0.0, 2.0, Ends::OpenLow);
     else if (k == "pca_variance") o.pca_variance = real_arg(v, k, 0.0, 1.0, Ends::OpenLow);
     else if (k == "max_pca_dims") o.max_pca_dims = int_arg(v, k, 1, 4096);
@@ -162,7 +162,7 @@ exemplar: (H, W) or (H, W, C) uint8/uint16 (scaled to [0, 1]) or float; used for
 without its own. exemplar_y / exemplar_z: the y- and z-slice exemplars (same channels).
 views: active slices, 'xyz' or two of them. constraint: (size, size, size, C + 1) float32:
 target values then a weight in [0, 1]. Options (keywords): levels=3, neighborhood=8,
-iterations=3, finest_iterations=0 (rounds at the finest level; 0 = iterations), r=0.8, pca_variance=0.95, max_pca_dims=32,
+iterations=3, finest_iterations=-1 (rounds at the finest level; 0 = iterations; -1 = 2 from 64 voxels across), r=0.8, pca_variance=0.95, max_pca_dims=32,
 search='kcoherence'|'kdtree'|'exact', coherence_k=4, random_candidates=2, ann_eps=2.0, histogram_matching=True, histogram_bins=16, histogram_strength=3
 ((1 + excess)^-strength re-weighting; 1 = gentle),
 mean_shift=False, coherent_upsampling=True, exemplar_values=True, feature_weight=0 (> 0: feature-distance channel), tileable=True,

@@ -223,6 +223,19 @@ TEST(Solid, FinestIterationsSetsTheFinestLevelsRounds) {
   EXPECT_EQ(std::count(d.energy_level.begin(), d.energy_level.end(), 1), 3);
 }
 
+TEST(Solid, FinestRoundsByDefaultDependOnTheSize) {
+  // The default (-1): every round below kAutoFinestFrom voxels, kAutoFinestIterations from there.
+  SolidOptions o = small_options();
+  ASSERT_EQ(o.finest_iterations, -1);
+  for (const int size : {kAutoFinestFrom - 2, kAutoFinestFrom}) {
+    o.size = size;
+    const TextureResult r = synthesize_solid(one_exemplar(disc_texture(32, 32, 3, 1)), o);
+    EXPECT_EQ(std::count(r.energy_level.begin(), r.energy_level.end(), 1),
+              size < kAutoFinestFrom ? o.iterations : kAutoFinestIterations) << size;
+  }
+  EXPECT_EQ(ImageSynthesisOptions{}.finest_iterations, 0);  // images keep every round
+}
+
 TEST(Solid, FullWeightConstraintIsReproduced) {
   const Image ex = disc_texture(32, 32, 1, 13);
   SolidExemplars in = one_exemplar(ex);

@@ -64,7 +64,7 @@ FUNCTIONS = {
     "gaussian_pyramid": (call("gaussian_pyramid", VOL), {"levels": ("int", 1, 32), "wrap": "bool", "ctx": "ctx"}),
     "synthesize_solid": (call("synthesize_solid", IMG, size=8, levels=1, iterations=1), {
         "size": ("int", 1, 2048), "views": "str", "levels": ("int", 1, 8), "neighborhood": ("int", 3, 32),
-        "iterations": ("int", 1, 100), "finest_iterations": ("int", 0, 100), "r": ("real", 0, 2), "pca_variance": ("real", 0, 1),
+        "iterations": ("int", 1, 100), "finest_iterations": ("int", -1, 100), "r": ("real", 0, 2), "pca_variance": ("real", 0, 1),
         "max_pca_dims": ("int", 1, 4096), "search": "str", "coherence_k": ("int", 0, 64),
         "random_candidates": ("int", 0, 64), "ann_eps": ("real", 0, 1e6), "histogram_matching": "bool",
         "histogram_bins": ("int", 2, 256), "histogram_strength": ("real", 0, 16), "mean_shift": "bool",

@@ -41,15 +41,22 @@ enum class SolidSearch {
   Exact,       ///< brute force over every exemplar neighbourhood, full dimension (reference for tests)
 };
 
+/// finest_iterations = -1: this many rounds at the finest level once it is
+/// at least kAutoFinestFrom voxels (pixels) across.
+constexpr int kAutoFinestIterations = 2;
+constexpr int kAutoFinestFrom = 64;
+
 struct TextureOptimizationOptions {
   int levels = 3;                ///< pyramid levels (coarsest first: size / 2^(levels-1))
   int neighborhood = 8;          ///< n: n x n neighbourhoods (even or odd, >= 3)
   int iterations = 3;            ///< search + optimise rounds per level (coarsest gets 2x)
-  /// Rounds at the finest level (with 2 levels or more); 0 = `iterations`.
-  /// 2 for a 3-round solid: 64^3 solids of 8 exemplars change by <= 0.02 on
-  /// every quality measure and a 128^3 solid takes ~40 % less CPU, but the
-  /// two-view 6-channel test's structure margin is lost, so the default stays
-  /// 0 (docs/solid.md, third pass).
+  /// Rounds at the finest level (with 2 levels or more); 0 = `iterations`;
+  /// -1 (solids' default, SolidOptions) = kAutoFinestIterations once the
+  /// finest level is kAutoFinestFrom voxels across, else `iterations`. With
+  /// 2 rounds 64^3 solids of 8 exemplars change by <= 0.02 on every quality
+  /// measure and a 128^3 solid takes ~25 % less CPU, but at 24^3-32^3 the
+  /// last round still adds structure (docs/solid.md, third pass). Images
+  /// keep every round (0).
   int finest_iterations = 0;
   double r = 0.8;                ///< energy exponent (IRLS weights |s - e|^(r - 2))
   double pca_variance = 0.95;    ///< PCA keeps this fraction of variance ...
@@ -104,6 +111,7 @@ struct SolidExemplars {
 
 struct SolidOptions : TextureOptimizationOptions {
   int size = 64;  ///< output edge length in voxels (size^3)
+  SolidOptions() { finest_iterations = -1; }
 };
 
 struct TextureResult {

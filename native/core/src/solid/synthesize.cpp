@@ -29,7 +29,7 @@ void check_options(const TextureOptimizationOptions& o) {
   range("levels", o.levels, 1, 8, "");
   range("neighborhood", o.neighborhood, 3, 32, " (the paper uses 8)");
   range("iterations", o.iterations, 1, 100, "");
-  range("finest_iterations", o.finest_iterations, 0, 100, " (0 = iterations)");
+  range("finest_iterations", o.finest_iterations, -1, 100, " (0 = iterations, -1 = by size)");
   if (!(o.r > 0 && o.r <= 2)) throw InvalidInput("r must be in (0, 2], got " + std::to_string(o.r) + " (the paper uses 0.8)");
   if (!(o.pca_variance > 0 && o.pca_variance <= 1))
     throw InvalidInput("pca_variance must be in (0, 1], got " + std::to_string(o.pca_variance));
@@ -65,6 +65,15 @@ struct Dims {
 };
 
 /// Level sizes, coarsest first; each level halves (rounding up) like the pyramids.
+// The finest level's rounds (finest_iterations: > 0 as given, 0 = iterations,
+// -1 = by the level's size).
+int finest_rounds(const TextureOptimizationOptions& opt, const Dims& finest) {
+  if (opt.finest_iterations > 0) return opt.finest_iterations;
+  const int edge = std::max({finest.d[0], finest.d[1], finest.d[2]});
+  if (opt.finest_iterations < 0 && edge >= kAutoFinestFrom) return std::min(kAutoFinestIterations, opt.iterations);
+  return opt.iterations;
+}
+
 std::vector<Dims> level_dims(Dims finest, int levels) {
   std::vector<Dims> out(levels);
   out[levels - 1] = finest;
@@ -313,9 +322,7 @@ TextureResult optimize_texture(const Job& job, const TextureOptimizationOptions&
     const bool finest = l == L - 1;
     // finest_iterations applies from two levels on (a single level is also
     // the coarsest, which needs its 2x to converge).
-    const int iterations = coarsest ? 2 * opt.iterations
-                           : finest && opt.finest_iterations > 0 ? opt.finest_iterations
-                                                                 : opt.iterations;
+    const int iterations = coarsest ? 2 * opt.iterations : finest ? finest_rounds(opt, d) : opt.iterations;
     const bool exemplar_values = finest && opt.exemplar_values;
     // With exemplar values the finest level's last optimisation would be
     // overwritten voxel for voxel: the pass reads only the matches and
