@@ -43,4 +43,3 @@ def test_world_node_tree(capfd):
         tree = compat.ensure_node_tree(world)
     no_deprecation(capfd, record)
     assert tree is world.node_tree and "Background" in tree.nodes
-
