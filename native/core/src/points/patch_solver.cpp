@@ -312,7 +312,11 @@ void PatchSolver::blend(std::vector<LocalPoint>& fresh, std::vector<char>& keep_
   const int iters = opt_.blend_iterations;
   std::atomic<std::size_t> fallbacks{0};
   // Moves p a total fraction w of the way to its projection on `surface`,
-  // in `iters` steps (each re-projects from where the point now is).
+  // in `iters` steps (each re-projects from where the point now is). Where
+  // the projection does not settle, the two rays' hit is the target of the
+  // remaining steps too: the point moves along its normal toward it, so the
+  // rays from there would find the same crossing (they did for ~half of the
+  // 235 k pulls of the 197 k chainmail, at up to 8 evaluations a step).
   auto pull = [&](LocalPoint& pt, float w, const PointSurface& surface) {
     if (w <= 0) return;
     if (!surface.any_within(pt.p, max_move)) return;  // nothing to meet
@@ -320,14 +324,17 @@ void PatchSolver::blend(std::vector<LocalPoint>& fresh, std::vector<char>& keep_
     const Eigen::Vector3f start = pt.p;
     thread_local PointSurface::Cursor cursor;  // one neighbour query for all the steps, mostly
     cursor.centre = Eigen::Vector3f::Constant(std::numeric_limits<float>::infinity());
+    bool ray_target = false;
+    Projection pr;
     for (int k = 0; k < iters; ++k) {
-      Projection pr = surface.project(pt.p, 3, float(1e-2 * h_), &cursor);
-      if (!pr.converged || (pr.point - start).norm() > max_move) {
+      if (!ray_target) pr = surface.project(pt.p, 3, float(1e-2 * h_), &cursor);
+      if (!ray_target && (!pr.converged || (pr.point - start).norm() > max_move)) {
         Eigen::Vector3f hit, hit_n;
         if (!two_ray_hit(surface, pt.p, pt.n, ray_reach, float(h_), hit, hit_n)) return;
         if (k == 0) fallbacks.fetch_add(1, std::memory_order_relaxed);
         pr.point = hit;
         pr.normal = hit_n;
+        ray_target = true;
       }
       if (pr.normal.dot(pt.n) < 0) return;  // the other side of a sheet: leave it
       pt.p += alpha * (pr.point - pt.p);
