@@ -102,6 +102,21 @@ def test_the_measure_runs_off_the_main_thread(cow, monkeypatch):
     assert pattern_preview.pattern_for(bpy.context, cow, wait=True)["scale"] == pytest.approx(info["scale"], rel=0.01)
 
 
+def test_a_failing_measure_is_shown_once_not_retried(cow, monkeypatch):
+    calls = []
+
+    def fails(*args):
+        calls.append(1)
+        raise MemoryError("out of memory")
+
+    monkeypatch.setattr(analogy_ops, "fitted_pattern_scale", fails)
+    pattern_preview.detach()
+    pattern_preview.attach()
+    info = pattern_preview.pattern_for(bpy.context, cow, wait=True)
+    assert info == {"error": "cannot measure the model (out of memory)"}
+    assert pattern_preview.pattern_for(bpy.context, cow) is info and len(calls) == 1
+
+
 def test_fitted_scale_stays_in_the_pairs_range():
     """A slab 1/50 as thick as it is long would fit a pattern of 4 % of its
     side: at resolution 48 that is under the pair's 8 voxels, so it is raised."""

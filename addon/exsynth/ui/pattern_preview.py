@@ -28,7 +28,7 @@ COLOR = (1.0, 0.55, 0.1, 0.9)
 SEGMENTS = 64
 _cache = {}
 _handle = None
-_worker = {"thread": None, "key": None, "last": None}  # the measure running; (object name, info) of the last done
+_worker = {"thread": None, "last": None}  # the measure running; (object name, info) of the last done
 
 
 def _state_key(obj, resolution, fit, manual_scale):
@@ -69,9 +69,16 @@ def pattern_for(context, obj, wait=False):
         _store(key, obj.name, _measure(verts, tris, settings.geo_resolution, None, settings.geo_pattern_scale))
         return _cache[obj.name][1]
     name, resolution = obj.name, settings.geo_resolution  # read here: the thread must not touch bpy
-    thread = threading.Thread(target=lambda: _store(key, name, _measure(verts, tris, resolution, True)),
-                              name="exsynth pattern size", daemon=True)
-    _worker.update(thread=thread, key=key)
+
+    def work():
+        try:
+            info = _measure(verts, tris, resolution, True)
+        except Exception as exc:  # e.g. over the memory budget: said in the panel, not retried at every redraw
+            info = {"error": f"cannot measure the model ({exc})"}
+        _store(key, name, info)
+
+    thread = threading.Thread(target=work, name="exsynth pattern size", daemon=True)
+    _worker["thread"] = thread
     thread.start()
     if wait:
         thread.join()
@@ -184,4 +191,4 @@ def detach():
     thread = _worker["thread"]
     if thread is not None:
         thread.join()  # the add-on's module may go away with it
-    _worker.update(thread=None, key=None, last=None)
+    _worker.update(thread=None, last=None)
