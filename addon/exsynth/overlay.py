@@ -16,6 +16,7 @@ import bpy
 import numpy as np
 
 from . import compat, field_glyphs
+from .ui.redraw import tag_3d_views
 
 FIELD_ATTRIBUTE = "exsynth_field"
 TAIL_COLOUR = (0.05, 0.25, 0.9, 1.0)
@@ -45,7 +46,7 @@ def enable():
     global _handle
     if _handle is None:
         _handle = bpy.types.SpaceView3D.draw_handler_add(_draw, (), 'WINDOW', 'POST_VIEW')
-    _tag_redraw()
+    tag_3d_views()
 
 
 def disable():
@@ -54,7 +55,7 @@ def disable():
         bpy.types.SpaceView3D.draw_handler_remove(_handle, 'WINDOW')
         _handle = None
     _cache.update(key=None, geometry=None, topology_key=None, topology=None, batches=None, facing=None, visible=None)
-    _tag_redraw()
+    tag_3d_views()
 
 
 def sync(settings, _context=None):
@@ -63,14 +64,6 @@ def sync(settings, _context=None):
         enable()
     else:
         disable()
-
-
-def _tag_redraw():
-    wm = getattr(bpy.context, "window_manager", None)
-    for win in getattr(wm, "windows", ()):
-        for area in win.screen.areas:
-            if area.type == 'VIEW_3D':
-                area.tag_redraw()
 
 
 def field_object(context):

@@ -153,14 +153,18 @@ def find_tab():
     if state["tabs"] >= 8:
         check(False, "the ExSynth sidebar tab draws the Solid Texture panel")
     win = bpy.context.window_manager.windows[0]
-    area = next(a for a in win.screen.areas if a.type == 'VIEW_3D')
+    _next_sidebar_tab(win, next(a for a in win.screen.areas if a.type == 'VIEW_3D'))
+    return 0.3
+
+
+def _next_sidebar_tab(win, area):
+    """Ctrl+wheel over the sidebar's tab column: the next tab (counted in state)."""
     region = next(r for r in area.regions if r.type == 'UI')
     x, y = region.x + region.width - 8, region.y + region.height - 60
     win.event_simulate('MOUSEMOVE', 'NOTHING', x=x, y=y)
     win.event_simulate('WHEELDOWNMOUSE', 'PRESS', x=x, y=y, ctrl=True)
     area.tag_redraw()
     state["tabs"] += 1
-    return 0.3
 
 
 def solid_finish():
@@ -422,12 +426,7 @@ def paint_tab():
     if "EXSYNTH_PT_field" not in drawn:
         if state["tabs"] >= 8:
             check(False, "the Direction Field panel draws while painting")
-        ui = next(r for r in area.regions if r.type == 'UI')
-        x, y = ui.x + ui.width - 8, ui.y + ui.height - 60
-        win.event_simulate('MOUSEMOVE', 'NOTHING', x=x, y=y)
-        win.event_simulate('WHEELDOWNMOUSE', 'PRESS', x=x, y=y, ctrl=True)
-        area.tag_redraw()
-        state["tabs"] += 1
+        _next_sidebar_tab(win, area)
         return 0.3
     check(True, "the Direction Field panel draws while painting")
     rv3d = area.spaces.active.region_3d

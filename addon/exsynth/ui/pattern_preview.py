@@ -23,6 +23,7 @@ from .. import compat
 from ..io import mesh as mesh_io
 from ..jobs import InputError
 from ..operators import analogy as analogy_ops
+from .redraw import tag_3d_views
 
 COLOR = (1.0, 0.55, 0.1, 0.9)
 SEGMENTS = 64
@@ -123,10 +124,7 @@ def _redraw_when_measured():
     thread = _worker["thread"]
     if thread is not None and thread.is_alive():
         return 0.05
-    for window in getattr(bpy.context.window_manager, "windows", ()):
-        for area in window.screen.areas:
-            if area.type == 'VIEW_3D':
-                area.tag_redraw()
+    tag_3d_views()
     return None
 
 
