@@ -50,8 +50,11 @@ def world_mesh(obj):
     obj.data.vertices.foreach_get("co", co)
     tris = np.empty(3 * len(obj.data.loop_triangles), np.int32)
     obj.data.loop_triangles.foreach_get("vertices", tris)
-    m = np.array(obj.matrix_world)
-    return co.reshape(-1, 3) @ m[:3, :3].T + m[:3, 3], tris.reshape(-1, 3)
+    # float64 like the add-on's mesh_io.world_triangles: np.array of a
+    # mathutils Matrix is float32 from Blender 5.0 on, and the thickness
+    # measure moves by 0.1 % when the vertices move by 1e-7.
+    m = np.array(obj.matrix_world, dtype=np.float64)
+    return co.reshape(-1, 3).astype(np.float64) @ m[:3, :3].T + m[:3, 3], tris.reshape(-1, 3)
 
 
 def enclosed_volume(vertices, triangles):
