@@ -14,6 +14,8 @@ changed and where it was checked.
 - Wide lines: `gpu.state.line_width_set` above 1 is not honoured by every
   backend; the POLYLINE shaders (3.x and later) draw width themselves.
 - Node trees of new materials and worlds (`use_nodes`, deprecated in 5.0).
+- The sidebar's tab: `Region.active_panel_category` (in the 4.2.23 and
+  5.0.1 wheels' RNA, not in Debian's 3.4) names the tab a region shows.
 """
 
 import bpy
@@ -67,6 +69,13 @@ def set_line_style(shader, colour, width):
     shader.uniform_float("viewportSize", gpu.state.viewport_get()[2:])
     shader.uniform_float("lineWidth", width)
     shader.uniform_float("color", colour)
+
+
+def sidebar_tab(region):
+    """The tab (panel category) a sidebar region shows, or None where
+    Blender cannot tell: before 4.1, or before the region first drew."""
+    tab = getattr(region, "active_panel_category", None)
+    return tab if tab and tab != 'UNSUPPORTED' else None
 
 
 def ensure_node_tree(data):

@@ -4,6 +4,7 @@ default): the value the panel shows and the viewport draws
 (ui/pattern_preview.py) is the one the operator and the CLI use."""
 
 import re
+import types
 
 import bpy
 import numpy as np
@@ -155,3 +156,25 @@ def test_cli_fits_when_no_size_is_given(tmp_path, capsys):
     err = capsys.readouterr().err
     scale = float(re.search(r"pattern size ([\d.]+) of B's longest side, fitted to its thickness", err).group(1))
     assert 0.1 < scale < 0.5 and out.exists()
+
+
+class _Region:
+    def __init__(self, type, tab=None):
+        self.type = type
+        if tab is not None:
+            self.active_panel_category = tab
+
+
+def _view(sidebar, *regions):
+    return types.SimpleNamespace(show_region_ui=sidebar), types.SimpleNamespace(regions=list(regions))
+
+
+def test_the_sphere_shows_only_with_the_exsynth_sidebar():
+    shows = pattern_preview.sidebar_shows_exsynth
+    assert shows(*_view(True, _Region('HEADER'), _Region('UI', "ExSynth"), _Region('WINDOW')))
+    assert not shows(*_view(True, _Region('UI', "Item")))  # another tab
+    assert not shows(*_view(False, _Region('UI', "ExSynth")))  # sidebar closed
+    assert shows(*_view(True, _Region('UI')))  # Blender 3.4: the tab is unknown, open is enough
+    assert shows(*_view(True, _Region('UI', 'UNSUPPORTED')))  # not drawn yet
+    assert not shows(None, None)  # drawn outside a 3D view's area
+    assert not shows(*_view(True, _Region('WINDOW')))

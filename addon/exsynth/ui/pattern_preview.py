@@ -11,6 +11,10 @@ releases the GIL; the thread touches no bpy data), one at a time; until it
 ends the panel says "measuring" and the sphere keeps the last size. A
 timer on the main thread redraws the viewport when a measure ends, and the
 redraw asks for the newest state, so a drag costs one measure at a time.
+
+The sphere is drawn only in 3D views whose sidebar is open on the ExSynth
+tab (Blender 3.4 cannot tell the tab: there, whenever the sidebar is open),
+so artists who never open Geometric Texture do not see it.
 """
 
 import math
@@ -149,11 +153,26 @@ def sphere_lines(centre, radius, segments=SEGMENTS):
     return np.concatenate(lines).astype(np.float32)
 
 
+def sidebar_shows_exsynth(space, area):
+    """True when a 3D view's sidebar is open on the ExSynth tab (where
+    Geometric Texture is), or open on an unknown tab (Blender 3.4)."""
+    from ..panels.main import CATEGORY  # here: the panels import this module
+    if space is None or area is None or not getattr(space, "show_region_ui", False):
+        return False
+    for region in area.regions:
+        if region.type == 'UI':
+            tab = compat.sidebar_tab(region)
+            return tab is None or tab == CATEGORY
+    return False
+
+
 def _draw():
     context = bpy.context
     settings = getattr(context.scene, "exsynth", None)
     obj = context.active_object
     if settings is None or not settings.geo_show_pattern or settings.geo_pair_source != 'BUILTIN':
+        return
+    if not sidebar_shows_exsynth(context.space_data, context.area):
         return
     if obj is None or obj.type != 'MESH' or context.mode != 'OBJECT':
         return
