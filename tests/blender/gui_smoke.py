@@ -32,7 +32,8 @@ def _raise(exc):
 
 
 addon_utils.enable("exsynth", default_set=True, handle_error=_raise)
-from exsynth import jobs  # noqa: E402  (needs the path set above)
+from exsynth import compat, jobs  # noqa: E402  (needs the path set above)
+from exsynth.ui import pattern_preview  # noqa: E402
 
 # EXSYNTH_GUI_FROM=paint_start runs only the last part (when working on it).
 state = {"step": os.environ.get("EXSYNTH_GUI_FROM", "start"), "ctx": None, "t0": 0.0}
@@ -188,11 +189,29 @@ def _in_viewport(fn):
         return fn()
 
 
+def _record_sphere_draws():
+    """The pattern sphere's draw callback got as far as its line shader's
+    uniforms (both looked up at call time, so wrapping them here counts)."""
+    lines, style = pattern_preview.sphere_lines, compat.set_line_style
+
+    def recording_lines(*args, **kw):
+        drawn.add("sphere lines")
+        return lines(*args, **kw)
+
+    def recording_style(*args, **kw):
+        style(*args, **kw)
+        if "sphere lines" in drawn:
+            drawn.add("pattern sphere")
+
+    pattern_preview.sphere_lines, compat.set_line_style = recording_lines, recording_style
+
+
 def geo_start():
     bpy.data.batch_remove(list(bpy.data.objects))
     bpy.ops.wm.obj_import(filepath=os.path.join(ROOT, "assets", "meshes", "bunny.obj"))
     bpy.context.scene.exsynth.geo_resolution = 48
     _record_draws(bpy.types.EXSYNTH_PT_geometric_texture)
+    _record_sphere_draws()
     _in_viewport(lambda: bpy.ops.ed.undo_push(message="before Geometric Texture"))
     check(invoke_in_viewport("geometric_texture") == {'RUNNING_MODAL'}, "Geometric Texture runs modal")
     state.update(step="geo_finish", t0=time.monotonic())
@@ -206,6 +225,7 @@ def geo_finish():
         return 0.05
     check(names() == ["bunny", "bunny_spikes"], "Geometric Texture adds 'bunny_spikes'")
     check("EXSYNTH_PT_geometric_texture" in drawn, "the Geometric Texture panel draws without errors")
+    check("pattern sphere" in drawn, "the pattern sphere draws at the bunny while the ExSynth sidebar is open")
     _in_viewport(lambda: bpy.ops.ed.undo())
     state.update(step="geo_undone")
     return 0.3
