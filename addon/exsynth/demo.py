@@ -13,26 +13,24 @@ import bpy
 import numpy as np
 from mathutils import Vector
 
-from . import compat
+from . import demo_stage
 from .io import materials
 from .io import mesh as mesh_io
-from .io.selection import select_only
 
-RESOLUTION_PX = (480, 360)
 BUNNY_HEIGHT = 2.0  # the OBJ is ~10 units tall; scaled to a Blender-sized prop
 
 
 def run(bunny_path, out_dir, resolution=96, samples=16):
     t0 = time.perf_counter()
     bpy.ops.wm.read_homefile(use_empty=True)  # keeps registered add-ons
-    _ensure_addon()
+    demo_stage.ensure_addon()
 
     # The OBJ importer turns the file's Y-up into Blender's Z-up.
     bpy.ops.wm.obj_import(filepath=bunny_path)
     bunny = bpy.context.view_layer.objects.active
     bunny.name = "Bunny"
     bunny.scale = [BUNNY_HEIGHT / bunny.dimensions.z] * 3
-    _smooth(bunny.data)
+    demo_stage.smooth(bunny.data)
     bunny.data.materials.append(materials.new_surface_material("Demo Original", (0.55, 0.58, 0.62)))
 
     scene = bpy.context.scene
@@ -46,14 +44,14 @@ def run(bunny_path, out_dir, resolution=96, samples=16):
     volume = bpy.data.objects["Bunny_voxels"]
     remesh = bpy.data.objects["Bunny_voxel_mesh"]
 
-    _stage(scene, samples)
+    demo_stage.prepare_scene(scene, samples)
     centre = Vector((0.0, 0.0, 0.5 * BUNNY_HEIGHT))
 
     # 1. The Volume alone, where the bunny stood.
     bunny.hide_render = remesh.hide_render = True
     _thicken(volume)
-    _aim_camera(scene, centre, distance=7.0, side=0.35)
-    _render(scene, os.path.join(out_dir, "voxelize_volume.png"))
+    demo_stage.aim_camera(scene, centre, distance=7.0, side=0.35)
+    demo_stage.render(scene, os.path.join(out_dir, "voxelize_volume.png"))
     t3 = time.perf_counter()
 
     # 2. Original (left) beside the mesh rebuilt from the voxels (right).
@@ -62,8 +60,8 @@ def run(bunny_path, out_dir, resolution=96, samples=16):
     gap = 0.62 * bunny.dimensions.x
     bunny.location.x -= gap
     remesh.location.x += gap
-    _aim_camera(scene, centre, distance=10.0, side=0.1)
-    _render(scene, os.path.join(out_dir, "voxelize_mesh.png"))
+    demo_stage.aim_camera(scene, centre, distance=10.0, side=0.1)
+    demo_stage.render(scene, os.path.join(out_dir, "voxelize_mesh.png"))
     t4 = time.perf_counter()
 
     print(f"demo: voxelized the bunny at {resolution} voxels in {t2 - t1:.2f} s; renders "
@@ -82,12 +80,12 @@ def run_solid(cow_path, exemplar_path, out_dir, size=64, samples=16):
     inside of the same block of stone."""
     t0 = time.perf_counter()
     bpy.ops.wm.read_homefile(use_empty=True)
-    _ensure_addon()
+    demo_stage.ensure_addon()
     scene = bpy.context.scene
     view_layer = bpy.context.view_layer
 
     cow, dims = _cow_on_the_floor(cow_path)
-    _smooth(cow.data)
+    demo_stage.smooth(cow.data)
 
     # A box over the middle of the back, on the camera's side: the cut shows
     # the inside of the body.
@@ -111,12 +109,12 @@ def run_solid(cow_path, exemplar_path, out_dir, size=64, samples=16):
     settings.solid_scale = SOLID_SCALE
     settings.solid_bake_resolution = 1024
     t1 = time.perf_counter()
-    _select([cow])
+    demo_stage.select([cow])
     result = bpy.ops.exsynth.solid_texture()
     if result != {'FINISHED'}:
         raise RuntimeError(f"exsynth.solid_texture returned {result}")
     t2 = time.perf_counter()
-    _select([piece])
+    demo_stage.select([piece])
     result = bpy.ops.exsynth.solid_rebake()  # the solid Solid Texture just made
     if result != {'FINISHED'}:
         raise RuntimeError(f"exsynth.solid_rebake returned {result}")
@@ -125,14 +123,14 @@ def run_solid(cow_path, exemplar_path, out_dir, size=64, samples=16):
     # split open (the texture is baked: it moves with the piece).
     piece.rotation_euler.z += math.pi
     view_layer.update()
-    p_lo, p_hi = _world_bounds(piece)
+    p_lo, p_hi = demo_stage.world_bounds(piece)
     target = Vector((0.42 * dims.x, -1.5 * dims.y, 0.0))
     piece.location += target - Vector((0.5 * (p_lo[0] + p_hi[0]), 0.5 * (p_lo[1] + p_hi[1]), p_lo[2]))
 
-    _stage(scene, samples)
+    demo_stage.prepare_scene(scene, samples)
     centre = Vector((0.18 * dims.x, -0.6 * dims.y, 0.4 * dims.z))
-    _aim_camera(scene, centre, distance=4.6, side=0.3)
-    _render(scene, os.path.join(out_dir, "solid_texture.png"))
+    demo_stage.aim_camera(scene, centre, distance=4.6, side=0.3)
+    demo_stage.render(scene, os.path.join(out_dir, "solid_texture.png"))
     t4 = time.perf_counter()
     print(f"demo: solid {size}³ from {os.path.basename(exemplar_path)} and bake in {t2 - t1:.2f} s, "
           f"re-bake {t3 - t2:.2f} s; render {t4 - t3:.1f} s; total {t4 - t0:.1f} s -> {out_dir}")
@@ -146,7 +144,7 @@ def run_analogy(bunny_path, out_dir, resolution=128, pattern_size=0.4, samples=1
     grooves; analogy_pairs.png: spikes, pits, holes and grooves."""
     t0 = time.perf_counter()
     bpy.ops.wm.read_homefile(use_empty=True)
-    _ensure_addon()
+    demo_stage.ensure_addon()
     scene = bpy.context.scene
     view_layer = bpy.context.view_layer
 
@@ -156,13 +154,13 @@ def run_analogy(bunny_path, out_dir, resolution=128, pattern_size=0.4, samples=1
     view_layer.update()
     bunny.scale = [BUNNY_HEIGHT / bunny.dimensions.y] * 3  # local Y is world Z
     view_layer.update()
-    _smooth(bunny.data)
+    demo_stage.smooth(bunny.data)
     bunny.data.materials.append(materials.new_surface_material("Demo Original", (0.55, 0.58, 0.62)))
 
     settings = scene.exsynth
     _paint_strokes(bunny)
     settings.field_mode = 'DIFFUSE'
-    _select([bunny])
+    demo_stage.select([bunny])
     if bpy.ops.exsynth.direction_field() != {'FINISHED'}:
         raise RuntimeError("exsynth.direction_field did not finish")
     settings.geo_resolution = resolution
@@ -173,7 +171,7 @@ def run_analogy(bunny_path, out_dir, resolution=128, pattern_size=0.4, samples=1
                'GROOVES': (0.25, 0.45, 0.70)}
     for preset, rgb in colours.items():
         settings.geo_preset = preset
-        _select([bunny])
+        demo_stage.select([bunny])
         t = time.perf_counter()
         result = bpy.ops.exsynth.geometric_texture()
         if result != {'FINISHED'}:
@@ -187,7 +185,7 @@ def run_analogy(bunny_path, out_dir, resolution=128, pattern_size=0.4, samples=1
     # The results are in world space where the bunny is: rows of them move
     # by the same steps. 1: original, spikes, grooves.
     view_layer.update()
-    lo, hi = _world_bounds(bunny)
+    lo, hi = demo_stage.world_bounds(bunny)
     gap = 1.25 * float(hi[0] - lo[0])
     centre = Vector((0.5 * (lo[0] + hi[0]), 0.5 * (lo[1] + hi[1]), lo[2]))
     home = {obj.name: obj.location.copy() for obj in [bunny, *made.values()]}
@@ -199,16 +197,16 @@ def run_analogy(bunny_path, out_dir, resolution=128, pattern_size=0.4, samples=1
         for i, obj in enumerate(objects):
             obj.location += Vector(((i - 0.5 * (len(objects) - 1)) * gap, 0.0, 0.0)) - centre
 
-    _stage(scene, samples)
+    demo_stage.prepare_scene(scene, samples)
     row([bunny, made['SPIKES'], made['GROOVES']])
-    scene.render.resolution_x = 2 * RESOLUTION_PX[1]  # three bunnies side by side: wider
-    _aim_camera(scene, Vector((0.0, 0.0, 0.45 * BUNNY_HEIGHT)), distance=11.5, side=0.0)
-    _render(scene, os.path.join(out_dir, "analogy_bunny.png"))
+    scene.render.resolution_x = 2 * demo_stage.RESOLUTION_PX[1]  # three bunnies side by side: wider
+    demo_stage.aim_camera(scene, Vector((0.0, 0.0, 0.45 * BUNNY_HEIGHT)), distance=11.5, side=0.0)
+    demo_stage.render(scene, os.path.join(out_dir, "analogy_bunny.png"))
     # 2: the four built-in pattern pairs.
     row([made[p] for p in ('SPIKES', 'PITS', 'HOLES', 'GROOVES')])
-    scene.render.resolution_x = int(2.6 * RESOLUTION_PX[1])
-    _aim_camera(scene, Vector((0.0, 0.0, 0.45 * BUNNY_HEIGHT)), distance=14.5, side=0.0)
-    _render(scene, os.path.join(out_dir, "analogy_pairs.png"))
+    scene.render.resolution_x = int(2.6 * demo_stage.RESOLUTION_PX[1])
+    demo_stage.aim_camera(scene, Vector((0.0, 0.0, 0.45 * BUNNY_HEIGHT)), distance=14.5, side=0.0)
+    demo_stage.render(scene, os.path.join(out_dir, "analogy_pairs.png"))
     t2 = time.perf_counter()
     times = ", ".join(f"{p.lower()} {s:.2f} s" for p, s in seconds.items())
     print(f"demo: geometric texture at {resolution} voxels, pattern size {pattern_size}: {times}; "
@@ -228,7 +226,7 @@ def run_surface(cow_path, wood_path, ground_path, out_dir, samples=16):
     side by side."""
     t0 = time.perf_counter()
     bpy.ops.wm.read_homefile(use_empty=True)
-    _ensure_addon()
+    demo_stage.ensure_addon()
     scene = bpy.context.scene
     view_layer = bpy.context.view_layer
     cow, dims = _cow_on_the_floor(cow_path)
@@ -255,7 +253,7 @@ def run_surface(cow_path, wood_path, ground_path, out_dir, samples=16):
         settings.surface_height = height
         settings.surface_height_scale = 0.01
         t = time.perf_counter()
-        _select([cow])
+        demo_stage.select([cow])
         result = bpy.ops.exsynth.surface_texture()
         if result != {'FINISHED'}:
             raise RuntimeError(f"exsynth.surface_texture returned {result}")
@@ -265,12 +263,12 @@ def run_surface(cow_path, wood_path, ground_path, out_dir, samples=16):
     # Left to right: coherent wood, multiscale wood, coherent cracked ground + height.
     for i, obj in enumerate(results):
         obj.location.x += (i - 1) * 1.15 * dims.x
-        _smooth(obj.data)
+        demo_stage.smooth(obj.data)
     t1 = time.perf_counter()
-    _stage(scene, samples)
-    scene.render.resolution_x = int(2.6 * RESOLUTION_PX[1])
-    _aim_camera(scene, Vector((0.0, 0.0, 0.4 * dims.z)), distance=10.0, side=0.0)
-    _render(scene, os.path.join(out_dir, "surface_cow.png"))
+    demo_stage.prepare_scene(scene, samples)
+    scene.render.resolution_x = int(2.6 * demo_stage.RESOLUTION_PX[1])
+    demo_stage.aim_camera(scene, Vector((0.0, 0.0, 0.4 * dims.z)), distance=10.0, side=0.0)
+    demo_stage.render(scene, os.path.join(out_dir, "surface_cow.png"))
     t2 = time.perf_counter()
     made = ", ".join(f"{m} {e.name}{' + height' if h else ''} {dt:.1f} s" for (m, e, h, _), dt in zip(runs, times))
     print(f"demo: surface texture on the cow: {made}; render {t2 - t1:.1f} s; total {t2 - t0:.1f} s -> {out_dir}")
@@ -308,15 +306,12 @@ def _cow_on_the_floor(cow_path):
     view_layer.update()
     cow.scale = [COW_LENGTH / cow.dimensions.x] * 3
     view_layer.update()
-    lo, hi = _world_bounds(cow)
+    lo, hi = demo_stage.world_bounds(cow)
     cow.location -= Vector((0.5 * (lo[0] + hi[0]), 0.5 * (lo[1] + hi[1]), lo[2]))  # on the floor
     view_layer.update()
     return cow, Vector(hi - lo)
 
 
-def _world_bounds(obj):
-    corners = (np.array(obj.matrix_world) @ np.c_[np.array(obj.bound_box), np.ones(8)].T)[:3]
-    return corners.min(axis=1), corners.max(axis=1)
 
 
 def _box():
@@ -335,66 +330,12 @@ def _boolean(obj, cutter, operation):
         bpy.ops.object.modifier_apply(modifier=mod.name)
 
 
-def _select(objects):
-    select_only(bpy.context.view_layer, objects)
 
 
-def _ensure_addon():
-    if hasattr(bpy.types, "EXSYNTH_OT_voxelize"):
-        return
-    import addon_utils
-
-    def raise_error(exc):
-        raise exc
-
-    # The add-on's own module name: "exsynth", or "bl_ext.REPO.exsynth" when
-    # installed as an extension.
-    addon_utils.enable(__package__, default_set=True, handle_error=raise_error)
 
 
-def _stage(scene, samples):
-    scene.render.engine = 'CYCLES'
-    scene.cycles.device = 'CPU'
-    scene.cycles.samples = samples
-    scene.cycles.use_adaptive_sampling = False
-    # Debian's Blender has no OpenImageDenoise; denoising would fail the render.
-    scene.cycles.use_denoising = False
-    scene.cycles.max_bounces = 4
-    scene.render.resolution_x, scene.render.resolution_y = RESOLUTION_PX
-    scene.render.resolution_percentage = 100
-    scene.render.image_settings.file_format = 'PNG'
-    scene.view_settings.look = 'Medium Contrast'
-
-    world = bpy.data.worlds.new("Demo World")
-    background = compat.ensure_node_tree(world).nodes["Background"]
-    background.inputs["Color"].default_value = (0.30, 0.36, 0.46, 1.0)
-    background.inputs["Strength"].default_value = 0.5
-    scene.world = world
-
-    sun = bpy.data.objects.new("Sun", bpy.data.lights.new("Sun", 'SUN'))
-    sun.data.energy = 3.0
-    sun.data.angle = math.radians(8)
-    sun.rotation_euler = (math.radians(50), math.radians(10), math.radians(-35))
-    scene.collection.objects.link(sun)
-
-    size = 30.0
-    corners = np.array([[-1, -1, 0], [1, -1, 0], [1, 1, 0], [-1, 1, 0]], np.float32) * size
-    floor_mesh = mesh_io.new_mesh("Floor", corners, np.array([[0, 1, 2], [0, 2, 3]]))
-    floor_mesh.materials.append(materials.new_surface_material("Demo Floor", (0.12, 0.12, 0.13)))
-    scene.collection.objects.link(bpy.data.objects.new("Floor", floor_mesh))
-
-    camera = bpy.data.objects.new("Camera", bpy.data.cameras.new("Camera"))
-    camera.data.lens = 50
-    scene.collection.objects.link(camera)
-    scene.camera = camera
 
 
-def _aim_camera(scene, target, distance, side):
-    # From the front (-Y), slightly above; `side` turns it towards +X.
-    direction = Vector((side, -1.0, 0.35)).normalized()
-    camera = scene.camera
-    camera.location = target + distance * direction
-    camera.rotation_euler = (-direction).to_track_quat('-Z', 'Y').to_euler()
 
 
 def _thicken(volume):
@@ -403,14 +344,3 @@ def _thicken(volume):
     shader = volume.active_material.node_tree.nodes["Principled Volume"]
     shader.inputs["Density"].default_value = 4.0
     shader.inputs["Color"].default_value = (0.75, 0.85, 1.0, 1.0)
-
-
-def _render(scene, path):
-    scene.render.filepath = path
-    bpy.ops.render.render(write_still=True)
-
-
-def _smooth(mesh):
-    mesh.polygons.foreach_set("use_smooth", np.ones(len(mesh.polygons), bool))
-    mesh.update()
-

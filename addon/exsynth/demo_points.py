@@ -14,7 +14,7 @@ import time
 import bpy
 from mathutils import Vector
 
-from . import demo
+from . import demo, demo_stage
 from .io import materials
 from .operators import points as points_ops
 
@@ -35,9 +35,9 @@ def _grow(job, name_colour):
 def run(bunny_path, out_dir, samples=16, density=6000.0):
     t0 = time.perf_counter()
     bpy.ops.wm.read_homefile(use_empty=True)
-    demo._ensure_addon()
+    demo_stage.ensure_addon()
     scene = bpy.context.scene
-    demo._stage(scene, samples)
+    demo_stage.prepare_scene(scene, samples)
     lines = []
     for preset, rgb in (("chainmail", (0.75, 0.75, 0.78)), ("weave", (0.70, 0.50, 0.30))):
         opts = points_ops._native.point_texture_preset(preset)
@@ -47,12 +47,12 @@ def run(bunny_path, out_dir, samples=16, density=6000.0):
         result, (cloud, surf), secs = _grow(job, (f"Demo {preset}", rgb))
         cloud.location = (-2.2, -1.0, 0.0)
         surf.location = (0.2, -1.0, 0.0)
-        demo._aim_camera(scene, Vector((0.0, 0.0, 0.0)), distance=5.5, side=0.0)
+        demo_stage.aim_camera(scene, Vector((0.0, 0.0, 0.0)), distance=5.5, side=0.0)
         scene.render.resolution_x, scene.render.resolution_y = 640, 320
         for o in bpy.data.objects:
             if o.type == 'MESH' and o.name not in (cloud.name, surf.name, "Floor"):
                 o.hide_render = True
-        demo._render(scene, os.path.join(out_dir, f"points_{preset}.png"))
+        demo_stage.render(scene, os.path.join(out_dir, f"points_{preset}.png"))
         lines.append(f"{preset} {len(result.positions)} points in {secs:.1f} s")
         cloud.hide_render = surf.hide_render = True
 
@@ -61,7 +61,7 @@ def run(bunny_path, out_dir, samples=16, density=6000.0):
     bpy.context.view_layer.update()
     bunny.scale = [demo.BUNNY_HEIGHT / bunny.dimensions.y] * 3
     bpy.context.view_layer.update()
-    demo._smooth(bunny.data)
+    demo_stage.smooth(bunny.data)
     bunny.data.materials.append(materials.new_surface_material("Demo Bunny", (0.55, 0.30, 0.20)))
     s = scene.exsynth
     s.pts_output, s.pts_target, s.pts_scale = 'TARGET', bunny, 0.35
@@ -74,10 +74,10 @@ def run(bunny_path, out_dir, samples=16, density=6000.0):
     result, (cloud, surf), secs = _grow(job, ("Demo bunny chainmail", (0.78, 0.78, 0.82)))
     cloud.hide_render = True
     lo = Vector(bunny.bound_box[0])
-    demo._aim_camera(scene, bunny.matrix_world @ Vector((0, 0, 0)) + Vector((0, 0, 0.45 * demo.BUNNY_HEIGHT)),
+    demo_stage.aim_camera(scene, bunny.matrix_world @ Vector((0, 0, 0)) + Vector((0, 0, 0.45 * demo.BUNNY_HEIGHT)),
                      distance=6.0, side=0.3)
     scene.render.resolution_x, scene.render.resolution_y = 480, 400
-    demo._render(scene, os.path.join(out_dir, "points_bunny_chainmail.png"))
+    demo_stage.render(scene, os.path.join(out_dir, "points_bunny_chainmail.png"))
     lines.append(f"bunny chainmail {len(result.positions)} points in {secs:.1f} s (lo {tuple(lo)})")
     print(f"demo_points: {'; '.join(lines)}; total {time.perf_counter() - t0:.1f} s -> {out_dir}")
     return 0
