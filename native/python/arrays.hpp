@@ -30,6 +30,12 @@ TriangleMesh to_mesh(const py::handle& vertices, const py::handle& faces);
 /// Lists and tuples are converted by NumPy (see array_arg).
 Volume to_volume(const py::handle& a, const char* name, const GridTransform& xform);
 
+/// (H, W) or (H, W, C) uint8 / uint16 / float32 / float64 -> Image, in
+/// [0, 1] for integer types (8- and 16-bit exemplars), unchanged for floats.
+/// Finiteness and channel limits are the core's to check. The message names
+/// the argument.
+Image to_image(const py::handle& arg, const std::string& name);
+
 /// 3 finite numbers; the message names the argument and says what it means.
 Eigen::Vector3d to_point(const py::handle& h, const char* name, const char* meaning);
 

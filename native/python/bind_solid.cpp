@@ -12,33 +12,6 @@ namespace py = pybind11;
 namespace exsynth::py_bind {
 namespace {
 
-/// (H, W) or (H, W, C) uint8 / uint16 / float32 / float64 -> Image in [0, 1]
-/// for integer types (8- and 16-bit exemplars), unchanged for floats.
-Image to_image(const py::handle& arg, const std::string& name) {
-  const py::array a = array_arg(arg, name, "an (H, W) or (H, W, C) image array");
-  if (a.ndim() != 2 && a.ndim() != 3)
-    throw InvalidInput("'" + name + "' must be an (H, W) or (H, W, C) image array, got a " + describe(a));
-  const int h = int(a.shape(0)), w = int(a.shape(1)), c = a.ndim() == 3 ? int(a.shape(2)) : 1;
-  if (h < 1 || w < 1 || c < 1) throw InvalidInput("'" + name + "' is empty (" + describe(a) + ")");
-  Image img(w, h, c);
-  float* out = img.data();
-  const std::size_t count = img.values().size();
-  auto copy = [&](auto tag, float scale) {
-    using T = decltype(tag);
-    auto arr = py::array_t<T, py::array::c_style | py::array::forcecast>::ensure(a);
-    const T* src = arr.data();
-    for (std::size_t i = 0; i < count; ++i) out[i] = float(src[i]) * scale;
-  };
-  const auto dt = a.dtype();
-  if (dt.is(py::dtype::of<std::uint8_t>())) copy(std::uint8_t{}, 1.0f / 255.0f);
-  else if (dt.is(py::dtype::of<std::uint16_t>())) copy(std::uint16_t{}, 1.0f / 65535.0f);
-  else if (dt.is(py::dtype::of<float>())) copy(float{}, 1.0f);
-  else if (dt.is(py::dtype::of<double>())) copy(double{}, 1.0f);
-  else
-    throw InvalidInput("'" + name + "' must have dtype uint8, uint16, float32 or float64, got " + describe(a));
-  return img;
-}
-
 SolidSearch to_search(const std::string& s) {
   if (s == "kcoherence") return SolidSearch::KCoherence;
   if (s == "kdtree") return SolidSearch::KdTree;

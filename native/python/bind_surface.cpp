@@ -51,32 +51,6 @@ PolygonMesh to_polygon_mesh(const py::handle& vertices_arg, const py::handle& fa
   return m;
 }
 
-/// (H, W) or (H, W, C) uint8 / uint16 (scaled to [0, 1]) or float32 / float64.
-Image to_exemplar(const py::handle& arg) {
-  const py::array a = array_arg(arg, "exemplar", "an (H, W) or (H, W, C) image array");
-  if (a.ndim() != 2 && a.ndim() != 3)
-    throw InvalidInput("'exemplar' must be an (H, W) or (H, W, C) image array, got a " + describe(a));
-  const int h = int(a.shape(0)), w = int(a.shape(1)), c = a.ndim() == 3 ? int(a.shape(2)) : 1;
-  if (h < 1 || w < 1 || c < 1) throw InvalidInput("'exemplar' is empty (" + describe(a) + ")");
-  if (c > 16) throw InvalidInput("'exemplar' has " + std::to_string(c) + " channels; at most 16");
-  Image img(w, h, c);
-  const std::size_t count = img.values().size();
-  auto copy = [&](auto tag, float scale) {
-    using T = decltype(tag);
-    auto arr = py::array_t<T, py::array::c_style | py::array::forcecast>::ensure(a);
-    for (std::size_t i = 0; i < count; ++i) img.data()[i] = float(arr.data()[i]) * scale;
-  };
-  const auto dt = a.dtype();
-  if (dt.is(py::dtype::of<std::uint8_t>())) copy(std::uint8_t{}, 1.0f / 255.0f);
-  else if (dt.is(py::dtype::of<std::uint16_t>())) copy(std::uint16_t{}, 1.0f / 65535.0f);
-  else if (dt.is(py::dtype::of<float>())) copy(float{}, 1.0f);
-  else if (dt.is(py::dtype::of<double>())) copy(double{}, 1.0f);
-  else throw InvalidInput("'exemplar' must have dtype uint8, uint16, float32 or float64, got " + describe(a));
-  for (float x : img.values())
-    if (!std::isfinite(x)) throw InvalidInput("'exemplar' has NaN or Inf values");
-  return img;
-}
-
 std::vector<Eigen::Vector3f> to_field(const py::handle& arg, std::size_t vertices) {
   const py::array a = array_arg(arg, "field", "a (V, 3) float array, one vector per control vertex");
   check_shape(a, "field", {py::ssize_t(vertices), 3}, "(V, 3) float, one vector per control vertex");
@@ -167,7 +141,7 @@ void bind_surface(py::module_& m) {
         set_options(opt, out, kw);
         ExecContext* ctx = context_arg(ctx_arg);
         const PolygonMesh mesh = to_polygon_mesh(vertices, face_sizes, face_vertices);
-        const Image ex = to_exemplar(exemplar);
+        const Image ex = to_image(exemplar, "exemplar");
         if (!field.is_none()) opt.field = to_field(field, mesh.vertices.size());
         SurfaceResult r;
         {

@@ -248,6 +248,12 @@ def test_bad_options_and_arrays():
         _native.texture_surface(v, fs, fv, exemplar(16), face_resolution=512, memory_budget=1 << 20)
     with pytest.raises(_native.InvalidInputError, match="unknown option 'colour'"):
         _native.texture_surface(v, fs, fv, exemplar(16), colour=1)
+    with pytest.raises(_native.InvalidInputError, match="17 channels; at most 16"):
+        _native.texture_surface(v, fs, fv, np.zeros((16, 16, 17), np.float32))
+    with pytest.raises(_native.InvalidInputError, match="non-finite"):
+        _native.texture_surface(v, fs, fv, np.full((16, 16, 3), np.nan, np.float32))
+    with pytest.raises(_native.InvalidInputError, match="'exemplar' must have dtype"):
+        _native.texture_surface(v, fs, fv, np.zeros((16, 16, 3), np.int8))
     with pytest.raises(_native.InvalidInputError, match="method"):
         _native.texture_surface(v, fs, fv, exemplar(16), method="fast")
     with pytest.raises(_native.InvalidInputError, match="field"):

@@ -125,6 +125,9 @@ std::vector<Eigen::Vector3f> smooth_surface_field(const PolygonMesh& control, co
 
 enum class SurfaceMethod { Coherent, Multiscale };
 
+/// Most channels an exemplar may have (colour, alpha, height, ...).
+constexpr int kMaxSurfaceChannels = 16;
+
 struct SurfaceSynthesisOptions {
   SurfaceMethod method = SurfaceMethod::Coherent;
   /// Texels per unit of surface length; each ptex face gets

@@ -76,6 +76,9 @@ SurfaceTexture synthesize_surface(const SubdivSurface& surface, const Image& exe
                                   const SurfaceSynthesisOptions& opt, ExecContext* ctx) {
   validate_options(opt);
   if (exemplar.empty() || exemplar.channels() < 1) throw InvalidInput("exemplar is empty: give an image");
+  if (exemplar.channels() > kMaxSurfaceChannels)
+    throw InvalidInput("exemplar has " + std::to_string(exemplar.channels()) + " channels; at most " +
+                       std::to_string(kMaxSurfaceChannels));
   for (float x : exemplar.values())
     if (!std::isfinite(x)) throw InvalidInput("exemplar has non-finite values");
   const int need = opt.method == SurfaceMethod::Coherent ? 2 * opt.coherent_radius + 1 : opt.fine_neighborhood;
