@@ -10,13 +10,13 @@
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 
-#include <tbb/global_control.h>
 
 #include "exsynth/analogy.hpp"
 #include "exsynth/errors.hpp"
 #include "exsynth/pairs.hpp"
 #include "exsynth/rng.hpp"
 #include "support/volumes.hpp"
+#include "support/threads.hpp"
 
 using namespace exsynth;
 using ::testing::HasSubstr;
@@ -302,12 +302,9 @@ TEST(Analogy, SameInputSameResultWhateverTheThreadCount) {
   const double h = pair.a.transform().voxel_size;
   const Volume b = sphere_sdf(Volume(40, 40, 40, 1, 0.0f, centred(40, h)), 14 * h);
   const Volume field = around_z(b);
-  AnalogyResult one;
-  {
-    tbb::global_control single(tbb::global_control::max_allowed_parallelism, 1);
-    one = synthesize_analogy(pair.a, pair.a_prime, pair.field_a, b, field);
-  }
-  const AnalogyResult many = synthesize_analogy(pair.a, pair.a_prime, pair.field_a, b, field);
+  const auto run = [&] { return synthesize_analogy(pair.a, pair.a_prime, pair.field_a, b, field); };
+  const AnalogyResult one = exsynth::testing::on_threads(1, run);
+  const AnalogyResult many = exsynth::testing::on_threads(8, run);
   EXPECT_EQ(one.b_prime.values(), many.b_prime.values());
   EXPECT_EQ(one.searched, many.searched);
   EXPECT_EQ(one.coherent, many.coherent);

@@ -1,6 +1,5 @@
 // The analogy's band helpers and padding against brute-force references.
 #include <gtest/gtest.h>
-#include <tbb/global_control.h>
 
 #include <algorithm>
 #include <numeric>
@@ -11,6 +10,7 @@
 #include "analogy/features.hpp"
 #include "exsynth/analogy.hpp"
 #include "exsynth/errors.hpp"
+#include "support/threads.hpp"
 
 using namespace exsynth;
 
@@ -48,15 +48,9 @@ TEST(SortedBy, IsTheStableSortOfTheKeys) {
 TEST(SortedBy, SameOrderWhateverTheThreadCount) {
   const StageProgress none(nullptr, "", 0, 1, 1);
   const std::vector<float> key = keys_with_ties(300000, 5);
-  std::vector<std::uint32_t> one, eight;
-  {
-    tbb::global_control c(tbb::global_control::max_allowed_parallelism, 1);
-    one = analogy::sorted_by(key, none);
-  }
-  {
-    tbb::global_control c(tbb::global_control::max_allowed_parallelism, 8);
-    eight = analogy::sorted_by(key, none);
-  }
+  const auto run = [&] { return analogy::sorted_by(key, none); };
+  const std::vector<std::uint32_t> one = exsynth::testing::on_threads(1, run);
+  const std::vector<std::uint32_t> eight = exsynth::testing::on_threads(8, run);
   EXPECT_EQ(one, eight);
 }
 

@@ -1,12 +1,12 @@
 // Frames in volumes: orthonormal, N from the geometry, T following the field.
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
-#include <tbb/global_control.h>
 
 #include <cmath>
 
 #include "exsynth/frames.hpp"
 #include "support/shapes.hpp"
+#include "support/threads.hpp"
 
 using namespace exsynth;
 
@@ -74,17 +74,10 @@ TEST(Frames, OrthonormalRightHandedNormalFromGeometryTangentFromField) {
   EXPECT_GT(checked_t, 500);
 }
 
-TEST(Frames, SameWithOneOrTwoThreads) {
+TEST(Frames, SameWithOneOrEightThreads) {
   const SphereCase c = sphere_case(20);
-  VolumeFrames one, two;
-  {
-    tbb::global_control limit(tbb::global_control::max_allowed_parallelism, 1);
-    one = volume_frames(c.sdf, c.points, c.vectors);
-  }
-  {
-    tbb::global_control limit(tbb::global_control::max_allowed_parallelism, 2);
-    two = volume_frames(c.sdf, c.points, c.vectors);
-  }
+  const VolumeFrames one = exsynth::testing::on_threads(1, [&] { return volume_frames(c.sdf, c.points, c.vectors); });
+  const VolumeFrames two = exsynth::testing::on_threads(8, [&] { return volume_frames(c.sdf, c.points, c.vectors); });
   EXPECT_EQ(one.t.values(), two.t.values());
   EXPECT_EQ(one.b.values(), two.b.values());
 }

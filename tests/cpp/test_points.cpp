@@ -6,7 +6,6 @@
 #include <cmath>
 #include <random>
 
-#include <tbb/global_control.h>
 
 #include "exsynth/errors.hpp"
 #include "exsynth/points.hpp"
@@ -17,6 +16,7 @@
 #include "points/tps.hpp"
 #include "support/cancel.hpp"
 #include "support/shapes.hpp"
+#include "support/threads.hpp"
 
 using namespace exsynth;
 using V3 = Eigen::Vector3f;
@@ -298,15 +298,8 @@ TEST(PointTexture, DeterministicWhateverTheThreadCount) {
   const PointExemplar& ex = bumps_exemplar();
   PointTextureOptions o = small_options();
   o.seed = 11;
-  PointTextureResult a, b;
-  {
-    tbb::global_control one(tbb::global_control::max_allowed_parallelism, 1);
-    a = synthesize_points(ex, 1.0, 1.0, o);
-  }
-  {
-    tbb::global_control many(tbb::global_control::max_allowed_parallelism, 8);
-    b = synthesize_points(ex, 1.0, 1.0, o);
-  }
+  const PointTextureResult a = exsynth::testing::on_threads(1, [&] { return synthesize_points(ex, 1.0, 1.0, o); });
+  const PointTextureResult b = exsynth::testing::on_threads(8, [&] { return synthesize_points(ex, 1.0, 1.0, o); });
   ASSERT_EQ(a.points.size(), b.points.size());
   for (std::size_t i = 0; i < a.points.size(); ++i) {
     ASSERT_EQ(a.points.positions[i], b.points.positions[i]) << i;

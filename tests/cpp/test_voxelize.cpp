@@ -3,7 +3,6 @@
 // on open meshes, determinism across thread counts, cancel and bad input.
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
-#include <tbb/global_control.h>
 
 #include <atomic>
 #include <cmath>
@@ -14,6 +13,7 @@
 #include "exsynth/voxelize.hpp"
 #include "support/load_obj.hpp"
 #include "support/shapes.hpp"
+#include "support/threads.hpp"
 #include "voxel/triangle_distance.hpp"
 
 using namespace exsynth;
@@ -211,20 +211,13 @@ TEST(Voxelize, RayThroughSharedEdgeCountsOnce) {
   }
 }
 
-TEST(Voxelize, SameOutputWithOneOrTwoThreads) {
+TEST(Voxelize, SameOutputWithOneOrEightThreads) {
   const TriangleMesh m = exsynth::testing::load_obj(asset("meshes/cow.obj"));
   VoxelizeOptions opt;
   opt.resolution = 48;
   opt.seed = 7;
-  VoxelizeResult one, two;
-  {
-    tbb::global_control limit(tbb::global_control::max_allowed_parallelism, 1);
-    one = voxelize(m, opt);
-  }
-  {
-    tbb::global_control limit(tbb::global_control::max_allowed_parallelism, 2);
-    two = voxelize(m, opt);
-  }
+  const VoxelizeResult one = exsynth::testing::on_threads(1, [&] { return voxelize(m, opt); });
+  const VoxelizeResult two = exsynth::testing::on_threads(8, [&] { return voxelize(m, opt); });
   EXPECT_EQ(one.density.values(), two.density.values());
   EXPECT_EQ(one.sdf.values(), two.sdf.values());
 }
