@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "exsynth/parallel.hpp"
 #include "surface/charts.hpp"
@@ -146,6 +147,44 @@ namespace {
 /// Chart units a neighbourhood may span (r (|tau_a| + |tau_b|)) before it is
 /// marched whole: the star face is about one unit, its ring reaches two.
 constexpr double kChartReach = 2.0;
+
+/// A chart sample whose tangent-plane offset from the centre is further
+/// than this (in steps) from the asked one is corrected (below).
+constexpr double kChartTolerance = 0.05;
+constexpr int kChartCorrections = 3;
+
+/// Sample at 3D tangent offset d = l a - m b from c (position pc), placed
+/// through the chart, then corrected: the chart's straight lines are not
+/// the surface's where the real star differs from the regular one (a
+/// triangle's sub-faces: kite angles of 45-135 degrees laid out as 60 or
+/// 90 degree sectors; on a triangulated flat plane the uncorrected samples
+/// sat 0.19 steps from the plane grid on average, up to 1.6 steps). The
+/// correction is a fixed-Jacobian Newton step in the chart: the residual
+/// d - (P(p) - pc), in the (a, b) basis, mapped by the chart steps ta, tb.
+/// False where the chart ends (the sample is then marched); where the
+/// correction does not converge (strongly curved stars, where the chord
+/// from the centre is no longer the walked offset) the best iterate is kept.
+bool place_in_chart(const VertexCharts& charts, const TexelFrames& frames, int chart, int hint,
+                    const Eigen::Vector3d& pc, const Eigen::Vector2d& y0, const Eigen::Vector3d& d,
+                    const Eigen::Vector2d& ta, const Eigen::Vector2d& tb, double a2, double b2,
+                    const Eigen::Vector3d& a, const Eigen::Vector3d& b, bool landing_only, SurfacePoint& p) {
+  // The chart coordinate asked for: d = alpha a + beta b.
+  Eigen::Vector2d y = y0 + (d.dot(a) / a2) * ta + (d.dot(b) / b2) * tb;
+  double best = std::numeric_limits<double>::infinity();
+  SurfacePoint q = p;
+  for (int it = 0; it <= kChartCorrections; ++it) {
+    if (!charts.from_chart(chart, y, q, !landing_only, hint)) return false;
+    const Eigen::Vector3d r = d - (frames.approx(q).position - pc);
+    const double ra = r.dot(a) / a2, rb = r.dot(b) / b2, err = ra * ra + rb * rb;
+    if (err < best) {
+      best = err;
+      p = q;
+    }
+    if (err <= kChartTolerance * kChartTolerance) break;
+    y += ra * ta + rb * tb;
+  }
+  return true;
+}
 }  // namespace
 
 void chart_points(const SubdivSurface& surface, const TexelFrames& frames, const VertexCharts& charts,
@@ -175,6 +214,8 @@ void chart_points(const SubdivSurface& surface, const TexelFrames& frames, const
     return;
   }
   const int hint = charts.sector_of(chart, c.face);
+  const Eigen::Vector3d pc = frames.approx(c).position;
+  const double a2 = a.squaredNorm(), b2 = b.squaredNorm();
   SurfacePoint marched[kMaxSamples];
   bool marched_valid[kMaxSamples];
   bool have_march = false;
@@ -188,7 +229,8 @@ void chart_points(const SubdivSurface& surface, const TexelFrames& frames, const
         continue;
       }
       SurfacePoint p = c;
-      if (charts.from_chart(chart, y0 + double(l) * ta - double(m) * tb, p, !landing_only, hint)) {
+      if (place_in_chart(charts, frames, chart, hint, pc, y0, double(l) * a - double(m) * b, ta, tb, a2, b2, a, b,
+                         landing_only, p)) {
         out[k] = p;
         valid[k] = true;
         continue;
