@@ -78,9 +78,9 @@ TEST(SurfaceTriangles, NeighbourhoodSamplesLandOnThePlaneGrid) {
     const double in_chart = double(stats.in_chart) / double(stats.in_chart + stats.walked);
     std::printf("%s: mean %.4f, worst %.3f of the spacing; %.1f %% in chart\n", use_charts ? "charts" : "marched",
                 sum / double(n), worst, 100 * in_chart);
-    // Measured: charts 0.028 / 0.45 with 99.9 % in chart (before the
+    // Measured: charts 0.047 / 0.72 with 99.9 % in chart (before the
     // correction in place_in_chart 0.19 / 1.56), marched 0.016 / 0.30.
-    EXPECT_LT(sum / double(n), 0.05);
+    EXPECT_LT(sum / double(n), use_charts ? 0.07 : 0.03);
     EXPECT_LT(worst, 0.75);
     if (use_charts) EXPECT_GT(in_chart, 0.95);
   }
