@@ -159,9 +159,9 @@ constexpr int kChartCorrections = 2;
 /// from the regular one (a triangle's sub-faces: kite angles of 45-135
 /// degrees laid out as 60 or 90 degree sectors; on a triangulated flat plane
 /// the uncorrected samples sat 0.19 steps from the plane grid on average, up
-/// to 1.6 steps). The correction is a fixed-Jacobian Newton step in the
-/// chart: the residual d - (P(p) - pc), in the (a, b) basis, mapped by the
-/// chart steps ta, tb. False where the chart ends (the sample is then
+/// to 1.6 steps). The correction: quasi-Newton steps in the chart on the
+/// residual d - (P(p) - pc) in the (a, b) basis, starting from the chart
+/// steps ta, tb (at most kChartCorrections). False where the chart ends (the sample is then
 /// marched); where the correction does not converge (strongly curved stars,
 /// where the chord from the centre is no longer the walked offset) the best
 /// iterate is kept. y becomes the chart coordinate of the sample kept.
