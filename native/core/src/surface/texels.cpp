@@ -153,22 +153,23 @@ constexpr double kChartReach = 2.0;
 constexpr double kChartTolerance = 0.1;
 constexpr int kChartCorrections = 2;
 
-/// Sample at 3D tangent offset d = l a - m b from c (position pc), placed
-/// through the chart from the chart coordinate y, then corrected: the
+/// Sample at 3D tangent offset d = l a - m b from c (position pc, chart
+/// coordinate y0), placed through the chart, then corrected: the
 /// chart's straight lines are not the surface's where the real star differs
 /// from the regular one (a triangle's sub-faces: kite angles of 45-135
 /// degrees laid out as 60 or 90 degree sectors; on a triangulated flat plane
 /// the uncorrected samples sat 0.19 steps from the plane grid on average, up
 /// to 1.6 steps). The correction: quasi-Newton steps in the chart on the
 /// residual d - (P(p) - pc) in the (a, b) basis, starting from the chart
-/// steps ta, tb (at most kChartCorrections). False where the chart ends (the sample is then
-/// marched); where the correction does not converge (strongly curved stars,
+/// steps ta, tb (at most kChartCorrections). False where the chart ends
+/// (the sample is then marched); where the correction does not converge (strongly curved stars,
 /// where the chord from the centre is no longer the walked offset) the best
-/// iterate is kept. y becomes the chart coordinate of the sample kept.
+/// iterate is kept.
 bool place_in_chart(const VertexCharts& charts, const TexelFrames& frames, int chart, int hint,
-                    const Eigen::Vector3d& pc, const Eigen::Vector3d& d, const Eigen::Vector2d& ta,
-                    const Eigen::Vector2d& tb, double a2, double b2, const Eigen::Vector3d& a,
-                    const Eigen::Vector3d& b, bool landing_only, Eigen::Vector2d& y, SurfacePoint& p) {
+                    const Eigen::Vector3d& pc, const Eigen::Vector2d& y0, const Eigen::Vector3d& d,
+                    const Eigen::Vector2d& ta, const Eigen::Vector2d& tb, const Eigen::Vector3d& a,
+                    const Eigen::Vector3d& b, bool landing_only, SurfacePoint& p) {
+  const double a2 = a.squaredNorm(), b2 = b.squaredNorm();
   double best = std::numeric_limits<double>::infinity();
   // T maps a change of the offset, in (a, b) steps, to a chart step: the
   // chart steps at the centre first, then Broyden-updated from the iterates
@@ -177,8 +178,8 @@ bool place_in_chart(const VertexCharts& charts, const TexelFrames& frames, int c
   Eigen::Matrix2d T;
   T << ta, tb;
   const Eigen::Vector2d want(d.dot(a) / a2, d.dot(b) / b2);
-  Eigen::Vector2d yi = y, y_prev, f_prev;
-  const Eigen::Vector2d y_start = y;
+  const Eigen::Vector2d y_start = y0 + want.x() * ta + want.y() * tb;
+  Eigen::Vector2d yi = y_start, y_prev, f_prev;
   const double step2 = 2.0 * (ta.squaredNorm() + tb.squaredNorm());
   SurfacePoint q = p;
   for (int it = 0; it <= kChartCorrections; ++it) {
@@ -190,7 +191,6 @@ bool place_in_chart(const VertexCharts& charts, const TexelFrames& frames, int c
     if (err < best) {
       best = err;
       p = q;
-      y = yi;
     }
     if (err <= kChartTolerance * kChartTolerance) break;
     if (it > 0) {
@@ -237,7 +237,6 @@ void chart_points(const SubdivSurface& surface, const TexelFrames& frames, const
   }
   const int hint = charts.sector_of(chart, c.face);
   const Eigen::Vector3d pc = frames.approx(c).position;
-  const double a2 = a.squaredNorm(), b2 = b.squaredNorm();
   SurfacePoint marched[kMaxSamples];
   bool marched_valid[kMaxSamples];
   bool have_march = false;
@@ -250,10 +249,9 @@ void chart_points(const SubdivSurface& surface, const TexelFrames& frames, const
         valid[k] = true;
         continue;
       }
-      Eigen::Vector2d y = y0 + double(l) * ta - double(m) * tb;
       SurfacePoint p = c;
-      if (place_in_chart(charts, frames, chart, hint, pc, double(l) * a - double(m) * b, ta, tb, a2, b2, a, b,
-                         landing_only, y, p)) {
+      if (place_in_chart(charts, frames, chart, hint, pc, y0, double(l) * a - double(m) * b, ta, tb, a, b,
+                         landing_only, p)) {
         out[k] = p;
         valid[k] = true;
         continue;
