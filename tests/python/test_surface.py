@@ -180,11 +180,14 @@ def test_multiscale_on_a_flat_plane_scores_near_the_2d_synthesis_and_coherence_h
         v, fs, fv, ex8, field=field, face_resolution=r, seed=seed, method="multiscale", coherence=c), n, r), ex)
         for seed in (4, 5, 6, 7, 8)]) for c in (0.0, 1.0)}
     ref = nn_distance(_native.synthesize_image(ex8, width=n * r, height=n * r, seed=4)["image"], ex)
-    # Measured (mean of seeds 4-8, 80 windows): 0.451 with coherence (the
-    # default), 0.474 without (Wei-Levoy's search alone); the 2D synthesis
-    # 0.26. (Since the coarsest level takes every exemplar pixel the gap is
-    # small; one seed alone is too noisy to show it.)
-    assert got[1.0] < 1.9 * ref, f"multiscale {got[1.0]:.3f} vs 2D {ref:.3f}"
+    # Measured (mean of seeds 4-8, 80 windows): 0.387 with coherence (the
+    # default), 0.408 without (Wei-Levoy's search alone); the 2D synthesis
+    # 0.31 (seed 4): 1.25x. Before the finer levels started from the coarser
+    # level's sources upsampled: 0.451 (1.46x). (One seed alone is too noisy
+    # to show the coherence gap.) The absolute bound keeps the test about the
+    # surface method when the 2D synthesis changes.
+    assert got[1.0] < 0.42, f"multiscale {got[1.0]:.3f}"
+    assert got[1.0] < 1.5 * ref, f"multiscale {got[1.0]:.3f} vs 2D {ref:.3f}"
     assert got[1.0] < 0.98 * got[0.0], f"with coherence {got[1.0]:.3f} vs without {got[0.0]:.3f}"
 
 
@@ -285,3 +288,46 @@ def test_vertex_charts_sample_the_flat_grid_exactly_as_walks_do(flat):
         assert b["chart_samples"] == 0 and b["walked_samples"] > 0
         # (4 x 4 faces: the stars next to the corners walk; measured 42-43 % in charts)
         assert a["chart_samples"] > 0.3 * (a["chart_samples"] + a["walked_samples"]), method
+
+
+def triangulated_grid(n):
+    """n x n unit squares in the z = 0 plane, each split into two triangles
+    (the cow's structure: valence-3 face centres, valence-4 edge midpoints,
+    valence-6 vertices)."""
+    xs = np.arange(n + 1, dtype=float)
+    v = np.array([(x, y, 0.0) for y in xs for x in xs])
+    faces = []
+    for j in range(n):
+        for i in range(n):
+            a, b, c, d = j * (n + 1) + i, j * (n + 1) + i + 1, (j + 1) * (n + 1) + i + 1, (j + 1) * (n + 1) + i
+            faces += [(a, b, c), (a, c, d)]
+    return v, np.full(len(faces), 3, np.int32), np.array(faces, np.int32).ravel()
+
+
+def test_patches_on_a_triangulated_plane_copy_the_exemplar_exactly():
+    # Coherent synthesis copies patches: neighbouring texels of one patch
+    # have sources that differ by exactly their offset on the surface (the
+    # kites' square texel grids are sheared, so the offsets are fractional).
+    # Neighbour offsets taken from the landing points (within the walk's or
+    # chart's tolerance of the asked offset) drifted the sources of a patch
+    # apart: median 0.10 px, 90th percentile 0.36 px, so a patch's texels
+    # rounded to other pixels than a copy would. Now 0 / 0 (99th: 0.15).
+    n = 6
+    v, fs, fv = triangulated_grid(n)
+    ex = exemplar()
+    field = np.tile([1.0, 0.0, 0.0], (len(v), 1))
+    res = _native.texture_surface(v, fs, fv, ex, field=field, texels_per_unit=12, seed=4)
+    r, off = res["face_resolution"], res["face_offset"]
+    faces = np.repeat(np.arange(len(r)), r * r)
+    k = np.arange(len(faces)) - off[faces]
+    uv = np.stack([(k % r[faces] + 0.5) / r[faces], (k // r[faces] + 0.5) / r[faces]], 1)
+    pos = _native.surface_limit_points(v, fs, fv, faces, uv)["position"]
+    h = res["sample_spacing"]
+    drift = res["source"] - np.stack([pos[:, 0], -pos[:, 1]], 1) / h  # constant over a patch
+    # Texel pairs within 1.5 spacings (brute force), same patch = sources within a pixel of the offset.
+    d2 = ((pos[:, None, :2] - pos[None, :, :2]) ** 2).sum(-1)
+    i, j = np.nonzero(np.triu(d2 < (1.5 * h) ** 2, 1))
+    mismatch = np.linalg.norm(drift[i] - drift[j], axis=1)
+    same = mismatch < 1.0
+    assert same.mean() > 0.85, same.mean()  # measured 0.93: large patches
+    assert np.percentile(mismatch[same], 90) < 0.05, np.percentile(mismatch[same], 90)

@@ -77,8 +77,8 @@ void nearest_exemplar(const Image& ex, double x, double y, bool wrap, float* out
 
 /// Per texel, its (2r+1)^2 - 1 neighbours (the centre left out): the texel
 /// each sample lands in (-1 past a boundary) and that texel's offset in
-/// exemplar pixels, corrected by the first-order vector from the landing
-/// point to the texel's centre projected on (v1, -v2). Built in parallel
+/// exemplar pixels: the chord between the two centres on (v1, -v2) / h
+/// (see below). Built in parallel
 /// before the (sequential) synthesis.
 struct NeighbourTable {
   int per = 0;
@@ -112,13 +112,29 @@ NeighbourTable neighbour_table(const SubdivSurface& surface, const TexelFrames& 
           tab.texel[at++] = -1;
           continue;
         }
-        const SurfacePoint& p = pts[k];
-        const std::size_t q = fr.grid.texel(p);
-        const SurfacePoint c = fr.grid.centre(q);
-        const Eigen::Vector3d to_centre =
-            fr.du[q].cast<double>() * (c.u - p.u) + fr.dv[q].cast<double>() * (c.v - p.v);
+        const std::size_t q = fr.grid.texel(pts[k]);
+        // The offset between the two texel centres themselves (their cached
+        // limit positions, in t's tangent frame), not (l, m) corrected from
+        // the landing point: the landing point is only within the walk's
+        // (or chart's) tolerance of h (l v1 - m v2), and that error, copied
+        // from texel to texel, made the float sources of a patch drift apart
+        // by fractions of a pixel, so its texels rounded to different pixels
+        // (on small faces and triangles' sub-faces; exact on the flat grid).
+        // Where the surface curves so much within the neighbourhood that
+        // the chord is more than a texel from the walked offset (a sample
+        // around a tight bend), the walked offset, corrected to the centre
+        // to first order, as before.
+        const Eigen::Vector3d chord = (fr.position[q] - fr.position[t]).cast<double>();
+        Eigen::Vector2d off(chord.dot(a) / h, -chord.dot(bb) / h);
+        if ((off - Eigen::Vector2d(l, m)).squaredNorm() > 1.0) {
+          const SurfacePoint& p = pts[k];
+          const SurfacePoint c = fr.grid.centre(q);
+          const Eigen::Vector3d to_centre =
+              fr.du[q].cast<double>() * (c.u - p.u) + fr.dv[q].cast<double>() * (c.v - p.v);
+          off = Eigen::Vector2d(l + to_centre.dot(a) / h, m - to_centre.dot(bb) / h);
+        }
         tab.texel[at] = std::int32_t(q);
-        tab.offset[at++] = Eigen::Vector2f(float(l + to_centre.dot(a) / h), float(m - to_centre.dot(bb) / h));
+        tab.offset[at++] = off.cast<float>();
       }
     }
     in_chart += stats.in_chart;

@@ -82,7 +82,10 @@ struct ChartStats;
 /// face nearest to it, the steps a, b (3D, in c's tangent plane) become
 /// chart steps through the chart's Jacobian and the surface derivatives
 /// du, dv at c (least squares, as a walk's first step), and sample (l, m)
-/// at y + l tau_a - m tau_b is mapped back to the face it falls in. Samples
+/// at y + l tau_a - m tau_b is mapped back to the face it falls in, then
+/// moved within the chart until its offset from c is l a - m b to 0.1 step
+/// (at most 2 quasi-Newton steps: the regular chart layout bends straight
+/// lines where the real star's angles differ, as on triangles). Samples
 /// where the chart ends (past its ring, a boundary, a T-junction; corners
 /// without a chart) are walked from c instead. stats (optional) counts both.
 void chart_points(const SubdivSurface& surface, const TexelFrames& frames, const VertexCharts& charts,
