@@ -127,13 +127,52 @@ struct TextureResult {
 TextureResult synthesize_solid(const SolidExemplars& exemplars, const SolidOptions& opt = {},
                                ExecContext* ctx = nullptr);
 
+/// How synthesize_image makes an image.
+enum class ImageMethod {
+  /// Default: synthesis of exemplar coordinates (Lefebvre & Hoppe 2005,
+  /// "Parallel Controllable Texture Synthesis", in the appearance space of
+  /// Lefebvre & Hoppe 2006); colours are looked up at the end, so every
+  /// pixel is an exemplar pixel (docs/solid.md, "2D: coordinate synthesis").
+  Coordinates,
+  Optimization,  ///< the texture optimiser above (Kopf et al. 2007 in 2D)
+};
+
+/// Options of ImageMethod::Coordinates (the optimiser ignores them; of the
+/// shared options it uses tileable, max_exemplar_size and seed).
+struct CoordinateSynthesisOptions {
+  /// Randomness r of the jitter: after upsampling, each pixel's coordinate
+  /// moves by round(h * r * U(-1, 1)) per axis at levels of spacing h >=
+  /// jitter_from (LH05's J_l). More jitter = smaller coherent patches (less
+  /// copying) but more seams (higher nn_rel); docs/solid.md has the sweep.
+  double jitter = 0.5;
+  int jitter_from = 2;           ///< finest spacing (power of two) that is still jittered
+  int corrections = 2;           ///< correction passes per level (each of 4 sub-passes)
+  int coherence_k = 2;           ///< k-coherence candidates per neighbour (1 = the coherent one only)
+  /// Coherence bias: a candidate that continues a neighbour's patch wins
+  /// unless another's distance is smaller by the factor (1 + coherence).
+  double coherence = 0.0;
+  /// Levels of spacing <= this compare 5 x 5 neighbourhoods of appearance
+  /// vectors instead of 3 x 3 (0 = 3 x 3 everywhere).
+  int wide_below = 0;
+  int appearance_window = 5;     ///< appearance vectors: PCA of this window's colours ...
+  int appearance_dims = 8;       ///< ... to this many dimensions (LH06: 5 x 5 -> 8)
+  /// Spacing of the coarsest level (a power of two); 0 = the largest power
+  /// of two <= the exemplar's shorter edge / 8.
+  int coarsest_spacing = 0;
+  /// Exhaustive correction (every exemplar position is a candidate): the
+  /// reference the tests compare the k-coherence search with.
+  bool exhaustive = false;
+};
+
 struct ImageSynthesisOptions : TextureOptimizationOptions {
   int width = 128;
   int height = 128;
+  ImageMethod method = ImageMethod::Coordinates;
+  CoordinateSynthesisOptions coordinates;
   ImageSynthesisOptions() { tileable = false; }
 };
 
-/// 2D texture optimisation: exemplar -> a width x height image.
+/// 2D synthesis: exemplar -> a width x height image, by `opt.method`.
 Image synthesize_image(const Image& exemplar, const ImageSynthesisOptions& opt = {}, ExecContext* ctx = nullptr,
                        std::vector<double>* energy = nullptr);
 
