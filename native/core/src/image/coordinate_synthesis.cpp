@@ -59,6 +59,11 @@ void check_coordinate_options(const CoordinateSynthesisOptions& o) {
   if (o.coherence_k < 1 || o.coherence_k > kMaxCoherenceK)
     throw InvalidInput("coherence_k must be between 1 and " + std::to_string(kMaxCoherenceK) +
                        " for the coordinate method (1 = coherent candidates only), got " + std::to_string(o.coherence_k));
+  if (!(o.coherence >= 0 && o.coherence <= 100))
+    throw InvalidInput("coherence must be between 0 and 100 (0 = no bias to continuing patches), got " +
+                       std::to_string(o.coherence));
+  if (o.wide_below < 0 || o.wide_below > 1024)
+    throw InvalidInput("wide_below must be between 0 and 1024 pixels of spacing, got " + std::to_string(o.wide_below));
   if (o.appearance_window < 1 || o.appearance_window > 15 || o.appearance_window % 2 == 0)
     throw InvalidInput("appearance_window must be odd, from 1 to 15 pixels, got " + std::to_string(o.appearance_window));
   if (o.appearance_dims < 1 || o.appearance_dims > 64)
@@ -398,6 +403,7 @@ Image synthesize_coordinates(const Image& exemplar, const ImageSynthesisOptions&
     while (std::max(working.width(), working.height()) > opt.max_exemplar_size) working = downsample(working, Boundary::Clamp);
     ex = &working;
   }
+  prepare.check();
   const CoordinateSolver solver(*ex, opt.coordinates, opt.tileable, opt.seed, ctx, 0.0, 0.15);
   const CoordImage s = solver.synthesize(opt.width, opt.height, ctx, 0.15, 1.0, energy);
   return solver.colours(s);
