@@ -142,8 +142,10 @@ TEST(ImageCoordinates, UpsamplingContinuesTheParentPatch) {
   for (int y = 0; y < child.height; ++y)
     for (int x = 0; x < child.width; ++x) {
       const Coord p = parent.at(x / 2, y / 2);
-      const Coord want{std::clamp(p.u + 4 * (x & 1), s.lowest().u, s.highest().u),
-                       std::clamp(p.v + 4 * (y & 1), s.lowest().v, s.highest().v)};
+      // Past the valid range a coordinate wraps to its other end (no smear of one clamped column).
+      const int nu = s.highest().u - s.lowest().u + 1, nv = s.highest().v - s.lowest().v + 1;
+      const Coord want{s.lowest().u + (p.u + 4 * (x & 1) - s.lowest().u) % nu,
+                       s.lowest().v + (p.v + 4 * (y & 1) - s.lowest().v) % nv};
       EXPECT_TRUE(child.at(x, y) == want);
     }
 }

@@ -144,20 +144,23 @@ struct CoordinateSynthesisOptions {
   /// moves by round(h * r * U(-1, 1)) per axis at levels of spacing h >=
   /// jitter_from (LH05's J_l). More jitter = smaller coherent patches (less
   /// copying) but more seams (higher nn_rel); docs/solid.md has the sweep.
-  double jitter = 0.5;
-  int jitter_from = 2;           ///< finest spacing (power of two) that is still jittered
+  double jitter = 0.25;
+  int jitter_from = 8;           ///< finest spacing (power of two) that is still jittered
   int corrections = 2;           ///< correction passes per level (each of 4 sub-passes)
-  int coherence_k = 2;           ///< k-coherence candidates per neighbour (1 = the coherent one only)
+  /// k-coherence candidates per neighbour (1 = the coherent one only). LH05
+  /// use 2; on the 8 exemplars 2 changed no measure by more than 0.01 and
+  /// cost 3x the CPU (docs/solid.md), so 1.
+  int coherence_k = 1;
   /// Coherence bias: a candidate that continues a neighbour's patch wins
   /// unless another's distance is smaller by the factor (1 + coherence).
-  double coherence = 0.0;
+  double coherence = 1.0;
   /// Levels of spacing <= this compare 5 x 5 neighbourhoods of appearance
   /// vectors instead of 3 x 3 (0 = 3 x 3 everywhere).
   int wide_below = 0;
   int appearance_window = 5;     ///< appearance vectors: PCA of this window's colours ...
   int appearance_dims = 8;       ///< ... to this many dimensions (LH06: 5 x 5 -> 8)
   /// Spacing of the coarsest level (a power of two); 0 = the largest power
-  /// of two <= the exemplar's shorter edge / 8.
+  /// of two <= a third of the exemplar's shorter edge (32 for 128^2).
   int coarsest_spacing = 0;
   /// Exhaustive correction (every exemplar position is a candidate): the
   /// reference the tests compare the k-coherence search with.

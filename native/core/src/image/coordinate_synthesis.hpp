@@ -76,7 +76,14 @@ class CoordinateSolver {
   Coord highest() const { return {hi_u_, hi_v_}; }
 
  private:
-  Coord clamp(Coord c) const;
+  void build_similar(ExecContext* ctx, double lo, double hi);
+  /// The k - 1 exemplar positions most like valid position c (appearance vectors).
+  const Coord* similar(Coord c) const {
+    return similar_.data() + (std::size_t(c.v - lo_v_) * std::size_t(hi_u_ - lo_u_ + 1) + std::size_t(c.u - lo_u_)) *
+                                 std::size_t(opt_.coherence_k - 1);
+  }
+  Coord clamp(Coord c) const;  ///< into the valid range (wrapping)
+  bool valid(Coord c) const;
   /// Neighbour (x + dx, y + dy) in the output (wrapped when tileable); false when outside.
   bool neighbour(const CoordImage& s, int x, int y, int dx, int dy, int& nx, int& ny) const;
   void correct_pixel(const CoordImage& prev, CoordImage& out, int x, int y, int level, double& sum) const;
@@ -89,6 +96,7 @@ class CoordinateSolver {
   std::vector<Image> stack_;        ///< appearance at spacing 1, 2, 4, ... (finest first)
   std::vector<int> stack_spacing_;  ///< spacing of each stack entry
   int lo_u_ = 0, lo_v_ = 0, hi_u_ = 0, hi_v_ = 0;  ///< valid coordinates (appearance window inside)
+  std::vector<Coord> similar_;      ///< k-coherence sets, k - 1 per valid position (row-major)
 };
 
 /// synthesize_image with ImageMethod::Coordinates (options checked there).
