@@ -47,6 +47,7 @@ SolidSearch to_search(const std::string& s) {
 }
 
 // The options both entry points share, in one place.
+// `more_names`, when given, replaces the list of options an unknown one is told.
 void set_common(TextureOptimizationOptions& o, const py::kwargs& kw, const char* more_names = "") {
   for (auto item : kw) {
     const std::string k = py::str(item.first);
@@ -74,12 +75,14 @@ void set_common(TextureOptimizationOptions& o, const py::kwargs& kw, const char*
     else if (k == "max_exemplar_size") o.max_exemplar_size = int_arg(v, k, 0, 1 << 16);
     else if (k == "memory_budget") o.memory_budget = memory_budget_arg(v, k);
     else if (k == "seed") o.seed = seed_arg(v, k);
+    else if (*more_names)
+      throw InvalidInput("unknown option '" + k + "'; options: " + more_names);
     else
       throw InvalidInput("unknown option '" + k +
                          "'; options: levels, neighborhood, iterations, finest_iterations, r, pca_variance, max_pca_dims, search, "
                          "coherence_k, random_candidates, ann_eps, histogram_matching, histogram_bins, histogram_strength, mean_shift, coherent_upsampling, "
                          "exemplar_values, "
-                         "feature_weight, tileable, max_exemplar_size, memory_budget, seed" + std::string(more_names));
+                         "feature_weight, tileable, max_exemplar_size, memory_budget, seed");
   }
 }
 
@@ -211,8 +214,9 @@ Returns {'solid': (Z, Y, X, C) float32, 'energy': [...], 'energy_level': [...]}.
         opt.width = int_arg(width, "width", 1, 16384, "pixels");
         opt.height = int_arg(height, "height", 1, 16384, "pixels");
         set_common(opt, set_image_options(opt, kw),
-                   ", method, jitter, jitter_from, corrections, candidates_k, appearance_window, appearance_dims, "
-                   "coarsest_spacing, exhaustive");
+                   "method, jitter, jitter_from, corrections, candidates_k, coherence, wide_below, "
+                   "appearance_window, appearance_dims, coarsest_spacing, exhaustive, tileable, max_exemplar_size, "
+                   "seed; with method='optimization' also synthesize_solid's (levels, neighborhood, iterations, ...)");
         Image img;
         std::vector<double> energy;
         {
