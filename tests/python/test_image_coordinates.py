@@ -24,13 +24,17 @@ def case(request):
 
 
 def test_sharpness_and_contrast_floor(case):
-    # Measured (64^2 -> 96^2, seed 7): see the FLOORS comment in docs/solid.md's 2D section.
+    # Measured (64^2 -> 96^2, seed 7, default options), sharpness / contrast /
+    # nn_rel: crackedground 0.97 / 0.95 / 0.42, drkwood2 1.00 / 0.98 / 0.22;
+    # before coordinates wrapped in the valid range (they were clamped, a
+    # smear of one row or column) sharpness was 0.89 / 0.80.
     name, _, _, m = case
     assert m["sharpness"] >= 0.9 and m["contrast"] >= 0.8, (name, m)
     assert m["nn_rel"] <= 0.5, (name, m)  # structure, not noise (shuffled pixels score ~1)
 
 
 def test_copy_ceiling(case):
+    # Measured copy_rate / max_copy_frac: crackedground 0.16 / 0.16, drkwood2 0.34 / 0.24.
     name, _, _, m = case
     assert m["copy_rate"] <= 0.5 and m["max_copy_frac"] <= 0.5, (name, m)
 
@@ -43,18 +47,22 @@ def test_every_pixel_is_an_exemplar_pixel(case):
     assert all(tuple(p) in palette for p in got.tolist())
 
 
+def seam_ratios(img):
+    """Mean |difference| across the wrap-around seam (last column to first,
+    last row to first) over the mean between neighbouring columns / rows."""
+    across = np.abs(img[:, 0] - img[:, -1]).mean() / np.abs(np.diff(img, axis=1)).mean()
+    down = np.abs(img[0] - img[-1]).mean() / np.abs(np.diff(img, axis=0)).mean()
+    return across, down
+
+
 def test_tileable_output_continues_across_its_edges():
-    # A tileable image rolled by half is as good a texture as unrolled: the
-    # seam through the middle matches the exemplar like the rest.
+    # Measured (crackedground 64^2 -> 80x72, seeds 0-3): tileable 0.86-1.26,
+    # not tileable 1.58-2.04 (two unrelated edges).
     ex = exemplar("crackedground.png")
-    E = quality.Exemplar(ex)
-    img = _native.synthesize_image(ex, width=80, height=72, tileable=True, seed=3)["image"]
-    rolled = np.roll(img, (36, 40), axis=(0, 1))
-    nn = quality.image_metrics(E, img)["nn_rel"]
-    assert quality.image_metrics(E, rolled)["nn_rel"] <= 1.15 * nn + 0.02
-    plain = _native.synthesize_image(ex, width=80, height=72, tileable=False, seed=3)["image"]
-    assert quality.image_metrics(E, np.roll(plain, (36, 40), axis=(0, 1)))["nn_rel"] > quality.image_metrics(
-        E, rolled)["nn_rel"]
+    for seed in (0, 1):
+        tiled = seam_ratios(_native.synthesize_image(ex, width=80, height=72, tileable=True, seed=seed)["image"])
+        plain = seam_ratios(_native.synthesize_image(ex, width=80, height=72, seed=seed)["image"])
+        assert max(tiled) < 1.4 and min(plain) > 1.4, (seed, tiled, plain)
 
 
 def test_jitter_trades_copying_for_randomness():
@@ -81,9 +89,7 @@ def test_methods_and_sizes():
 
 
 def test_exhaustive_search_runs_on_a_tiny_input():
+    # The C++ tests compare it with the candidate search pixel by pixel; here the binding path.
     ex = exemplar("crackedground.png", size=16)
-    fast = _native.synthesize_image(ex, width=12, height=12, seed=2, coarsest_spacing=2)
-    slow = _native.synthesize_image(ex, width=12, height=12, seed=2, coarsest_spacing=2, exhaustive=True)
-    # Every pass of the exhaustive search ends at or below the k-coherence one's energy at the same level
-    # only for the first pass (later passes start from different states): compare the first entries.
-    assert slow["energy"][0] <= fast["energy"][0] + 1e-6
+    res = _native.synthesize_image(ex, width=12, height=12, seed=2, coarsest_spacing=2, exhaustive=True)
+    assert res["image"].shape == (12, 12, 3) and len(res["energy"]) == 2 * 2  # 2 levels x 2 corrections
