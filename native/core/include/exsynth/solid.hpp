@@ -1,6 +1,8 @@
 #pragma once
 // Solid texture synthesis from 2D exemplars (Kopf et al. 2007, "Solid
-// Texture Synthesis from 2D Exemplars") and the same optimiser in 2D.
+// Texture Synthesis from 2D Exemplars") and the same optimiser in 2D. Images
+// default to another method, synthesis of exemplar coordinates
+// (ImageMethod::Coordinates, native/core/src/image/coordinate_synthesis.hpp).
 //
 // Global texture optimisation: the energy is the sum over voxels v and the
 // three axis-aligned slices through v of ||s_v,i - e_v,i||^r, where s_v,i is
