@@ -215,7 +215,7 @@ Returns {'solid': (Z, Y, X, C) float32, 'energy': [...], 'energy_level': [...]}.
         opt.height = int_arg(height, "height", 1, 16384, "pixels");
         set_common(opt, set_image_options(opt, kw),
                    "method, jitter, jitter_from, corrections, candidates_k, coherence, wide_below, "
-                   "appearance_window, appearance_dims, coarsest_spacing, exhaustive, tileable, max_exemplar_size, "
+                   "appearance_window, appearance_dims, coarsest_spacing, exhaustive, tileable, max_exemplar_size, memory_budget, "
                    "seed; with method='optimization' also synthesize_solid's (levels, neighborhood, iterations, ...)");
         Image img;
         std::vector<double> energy;

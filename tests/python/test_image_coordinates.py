@@ -93,3 +93,9 @@ def test_exhaustive_search_runs_on_a_tiny_input():
     ex = exemplar("crackedground.png", size=16)
     res = _native.synthesize_image(ex, width=12, height=12, seed=2, coarsest_spacing=2, exhaustive=True)
     assert res["image"].shape == (12, 12, 3) and len(res["energy"]) == 2 * 2  # 2 levels x 2 corrections
+
+
+def test_over_the_memory_budget_is_refused_before_allocating():
+    ex = exemplar("crackedground.png", size=64)
+    with pytest.raises(_native.OverBudgetError, match="image synthesis of 4000x4000 .*raise the memory budget"):
+        _native.synthesize_image(ex, width=4000, height=4000, memory_budget=1 << 20)

@@ -7,6 +7,7 @@
 #include <utility>
 
 #include "exsynth/errors.hpp"
+#include "exsynth/memory_budget.hpp"
 #include "exsynth/parallel.hpp"
 #include "exsynth/pyramid.hpp"
 #include "exsynth/rng.hpp"
@@ -453,6 +454,20 @@ Image synthesize_coordinates(const Image& exemplar, const ImageSynthesisOptions&
     ex = &working;
   }
   prepare.check();
+  {
+    // Peak: the index's windows (n^2 C floats per pixel) and coefficients,
+    // the appearance stack (8 floats per pixel per level, ~log2(edge)
+    // levels), and per output pixel two coordinate images and the colours.
+    const double n = opt.coordinates.appearance_window, px = double(ex->pixel_count());
+    const double levels = std::log2(std::max(2, std::min(ex->width(), ex->height()))) + 1;
+    const double bytes = 4.0 * px * (n * n * ex->channels() + 8.0 * (levels + 2)) +
+                         double(opt.width) * opt.height * (16.0 + 4.0 * ex->channels());
+    check_memory_budget(bytes, opt.memory_budget,
+                        "image synthesis of " + std::to_string(opt.width) + "x" + std::to_string(opt.height) +
+                            " from a " + std::to_string(ex->width()) + "x" + std::to_string(ex->height()) +
+                            " working exemplar",
+                        "lower max_exemplar_size or the output size, or raise the memory budget");
+  }
   const CoordinateSolver solver(*ex, opt.coordinates, opt.tileable, opt.seed, ctx, 0.0, 0.15);
   const CoordImage s = solver.synthesize(opt.width, opt.height, ctx, 0.15, 1.0, energy);
   return solver.colours(s);
