@@ -81,6 +81,7 @@ BENCHMARK(BM_CancelLatencySolid)->Arg(64)->ArgName("size")->Unit(benchmark::kSec
 void BM_CancelLatencyImage(benchmark::State& state) {
   const exsynth::Image ex = exsynth::testing::disc_texture(int(state.range(0)), int(state.range(0)), 3, 5, 900, 24.0f);
   exsynth::ImageSynthesisOptions opt;
+  opt.method = exsynth::ImageMethod::Optimization;
   opt.width = opt.height = 256;
   report(state, "image", [&](exsynth::ExecContext* ctx) { exsynth::synthesize_image(ex, opt, ctx); });
 }

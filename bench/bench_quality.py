@@ -17,6 +17,7 @@ usage: bench_quality.py --build BUILD_DIR [--full] [--exemplars a,b] [--no-peers
 """
 import argparse
 import os
+import resource
 import shutil
 import struct
 import subprocess
@@ -71,9 +72,13 @@ EXSYNTH_CHILD = ("import sys, numpy as np; from PIL import Image; from exsynth i
 
 
 def whole_process(cmd, env=None):
+    """(wall seconds, CPU seconds user + sys) of one child process."""
+    r0 = resource.getrusage(resource.RUSAGE_CHILDREN)
     t = time.perf_counter()
     subprocess.run(cmd, check=True, env=env, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
-    return time.perf_counter() - t
+    wall = time.perf_counter() - t
+    r1 = resource.getrusage(resource.RUSAGE_CHILDREN)
+    return wall, (r1.ru_utime - r0.ru_utime) + (r1.ru_stime - r0.ru_stime)
 
 
 def row(label, m):
@@ -97,6 +102,8 @@ def main(argv=None):
     tmp = tempfile.mkdtemp(prefix="exsynth_bench_")
     print(f"machine: {os.cpu_count()} cores; 128^2 exemplars, {args.options or 'default options'}, seed 7; "
           "solids: mean of x/y/z slices")
+    print(f"image method: {opts.get('method', 'coordinates')} (synthesize_image's default: coordinates); "
+          f"load average at start {os.getloadavg()[0]:.1f}")
     header = f"{'output':<44} " + " ".join(f"{k:>9}" for k in KEYS)
     print(header)
     print("-" * len(header))
@@ -138,10 +145,12 @@ def main(argv=None):
         if peers:
             theirs.append(whole_process(["gmic", "-v", "-1", ex_png, "syntexturize_matchpatch", "256,256",
                                          "-o", os.path.join(tmp, "g.png")]))
-    print(f"  image 128^2 -> 256^2, exsynth (python module)   {np.median(ours):6.2f} s")
+    ow, oc = np.median([w for w, _ in ours]), np.median([c for _, c in ours])
+    print(f"  image 128^2 -> 256^2, exsynth (python module)   {ow:6.2f} s wall, {oc:5.2f} s CPU")
     if peers:
-        print(f"  image 128^2 -> 256^2, gmic syntexturize_matchpatch {np.median(theirs):6.2f} s"
-              f"   (exsynth / gmic = {np.median(ours) / np.median(theirs):.2f})")
+        tw, tc = np.median([w for w, _ in theirs]), np.median([c for _, c in theirs])
+        print(f"  image 128^2 -> 256^2, gmic syntexturize_matchpatch {tw:6.2f} s wall, {tc:5.2f} s CPU"
+              f"   (exsynth / gmic: wall {ow / tw:.2f}, CPU {oc / tc:.2f}; load {os.getloadavg()[0]:.1f})")
     ex = exemplar("crackedground")
     t = time.perf_counter()
     _native.synthesize_solid(ex, size=128, seed=7)

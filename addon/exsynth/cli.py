@@ -183,15 +183,18 @@ def _parser():
 
     p = sub.add_parser(
         "image", help="2D exemplar -> larger (optionally tileable) image",
-        description="2D texture synthesis with the solid engine's optimiser.",
+        description="2D texture synthesis: exemplar coordinates (Lefebvre & Hoppe 2005, the default) or the "
+                    "solid engine's optimiser (--method optimization).",
     )
     p.add_argument("--exemplar", required=True, help="exemplar image (any format Blender reads)")
     p.add_argument("--width", type=_int, required=True, help="output width in pixels")
     p.add_argument("--height", type=_int, required=True, help="output height in pixels")
     p.add_argument("--out", required=True, help="output image (.png)")
     p.add_argument("--tileable", action="store_true", help="make the output tile (opposite edges continue)")
-    p.add_argument("--levels", type=_int, default=3, help="coarse-to-fine levels (default 3)")
-    p.add_argument("--iterations", type=_int, default=3, help="optimisation rounds per level (default 3)")
+    p.add_argument("--method", choices=("coordinates", "optimization"), default="coordinates",
+                   help="coordinates (default: fast, every pixel an exemplar pixel) or optimization")
+    p.add_argument("--levels", type=_int, default=3, help="optimization: coarse-to-fine levels (default 3)")
+    p.add_argument("--iterations", type=_int, default=3, help="optimization: rounds per level (default 3)")
     p.add_argument("--seed", type=_seed, default=0, help="random seed (default 0)")
     p.add_argument("--alpha", action="store_true", help="synthesize the exemplar's alpha too")
     p.add_argument("--memory-budget", type=_gib, default=0.0,
@@ -537,7 +540,13 @@ def _run_image(args):
     _require(args.width > 0 and args.height > 0,
              f"--width and --height must be > 0 (got {args.width}x{args.height})")
     _require(args.levels > 0, f"--levels must be > 0 (got {args.levels})")
-    _texture_size("--width and --height", (args.width, args.height), args.levels, _native.IMAGE_MAX_SIZE, "pixels")
+    if args.method == "optimization":
+        _texture_size("--width and --height", (args.width, args.height), args.levels, _native.IMAGE_MAX_SIZE,
+                      "pixels")
+    else:
+        _require(max(args.width, args.height) <= _native.IMAGE_MAX_SIZE,
+                 f"--width and --height must be at most {_native.IMAGE_MAX_SIZE} pixels "
+                 f"(got {args.width}x{args.height})")
     _require(args.iterations > 0, f"--iterations must be > 0 (got {args.iterations})")
     _require(args.memory_budget >= 0, f"--memory-budget must be >= 0 GiB (got {args.memory_budget})")
 
@@ -546,12 +555,12 @@ def _run_image(args):
     job = solid_ops.ImageJob(
         exemplar=exemplar, width=args.width, height=args.height, tileable=args.tileable,
         levels=args.levels, iterations=args.iterations, seed=args.seed,
-        memory_budget=int(args.memory_budget * GIB),
+        memory_budget=int(args.memory_budget * GIB), method=args.method,
     )
     pixels, seconds = _run_job(job, "image")
     image_io.save_png(out, pixels[::-1], encoding)  # the engine's row 0 is the top
     tile = ", tileable" if args.tileable else ""
-    return (f"image: {args.width}x{args.height}{tile} from {os.path.basename(exemplar_path)} "
+    return (f"image ({args.method}): {args.width}x{args.height}{tile} from {os.path.basename(exemplar_path)} "
             f"in {seconds:.2f} s -> {args.out}")
 
 

@@ -20,7 +20,8 @@ SolidSearch to_search(const std::string& s) {
 }
 
 // The options both entry points share, in one place.
-void set_common(TextureOptimizationOptions& o, const py::kwargs& kw) {
+// `more_names`, when given, replaces the list of options an unknown one is told.
+void set_common(TextureOptimizationOptions& o, const py::kwargs& kw, const char* more_names = "") {
   for (auto item : kw) {
     const std::string k = py::str(item.first);
     const py::handle v = item.second;
@@ -47,6 +48,8 @@ void set_common(TextureOptimizationOptions& o, const py::kwargs& kw) {
     else if (k == "max_exemplar_size") o.max_exemplar_size = int_arg(v, k, 0, 1 << 16);
     else if (k == "memory_budget") o.memory_budget = memory_budget_arg(v, k);
     else if (k == "seed") o.seed = seed_arg(v, k);
+    else if (*more_names)
+      throw InvalidInput("unknown option '" + k + "'; options: " + more_names);
     else
       throw InvalidInput("unknown option '" + k +
                          "'; options: levels, neighborhood, iterations, finest_iterations, r, pca_variance, max_pca_dims, search, "
@@ -67,6 +70,37 @@ void check_constraint_weights(const Volume& c) {
     if (!(v[i] >= 0.0f && v[i] <= 1.0f))
       throw InvalidInput("'constraint' weights (its last channel) must be in [0, 1] (1 = take the target, 0 = ignore "
                          "it), got " + std::to_string(v[i]) + " at voxel " + std::to_string(i / std::size_t(channels)));
+}
+
+ImageMethod to_method(const std::string& s) {
+  if (s == "coordinates") return ImageMethod::Coordinates;
+  if (s == "optimization") return ImageMethod::Optimization;
+  throw InvalidInput("method must be 'coordinates' or 'optimization', got '" + s + "'");
+}
+
+/// synthesize_image's own options (method and the coordinate method's);
+/// the rest go to set_common.
+py::kwargs set_image_options(ImageSynthesisOptions& o, const py::kwargs& kw) {
+  py::kwargs rest;
+  CoordinateSynthesisOptions& c = o.coordinates;
+  for (auto item : kw) {
+    const std::string k = py::str(item.first);
+    const py::handle v = item.second;
+    // Ranges as image/coordinate_synthesis.cpp's check (which checks them again).
+    if (k == "method") o.method = to_method(string_arg(v, k, "'coordinates' or 'optimization'"));
+    else if (k == "jitter") c.jitter = real_arg(v, k, 0.0, 4.0, Ends::Closed, "times the level spacing");
+    else if (k == "jitter_from") c.jitter_from = int_arg(v, k, 1, 1024, "pixels (a power of two)");
+    else if (k == "corrections") c.corrections = int_arg(v, k, 0, 16);
+    else if (k == "candidates_k") c.coherence_k = int_arg(v, k, 1, 16);
+    else if (k == "coherence") c.coherence = real_arg(v, k, 0.0, 100.0);
+    else if (k == "wide_below") c.wide_below = int_arg(v, k, 0, 1024, "pixels (0 = 3 x 3 neighbourhoods everywhere)");
+    else if (k == "appearance_window") c.appearance_window = int_arg(v, k, 1, 15, "pixels (odd)");
+    else if (k == "appearance_dims") c.appearance_dims = int_arg(v, k, 1, 64);
+    else if (k == "coarsest_spacing") c.coarsest_spacing = int_arg(v, k, 0, 1024, "pixels (a power of two, 0 = auto)");
+    else if (k == "exhaustive") c.exhaustive = bool_arg(v, k);
+    else rest[item.first] = item.second;
+  }
+  return rest;
 }
 
 py::list to_list(const std::vector<double>& v) {
@@ -152,7 +186,10 @@ Returns {'solid': (Z, Y, X, C) float32, 'energy': [...], 'energy_level': [...]}.
         ImageSynthesisOptions opt;
         opt.width = int_arg(width, "width", 1, 16384, "pixels");
         opt.height = int_arg(height, "height", 1, 16384, "pixels");
-        set_common(opt, kw);
+        set_common(opt, set_image_options(opt, kw),
+                   "method, jitter, jitter_from, corrections, candidates_k, coherence, wide_below, "
+                   "appearance_window, appearance_dims, coarsest_spacing, exhaustive, tileable, max_exemplar_size, memory_budget, "
+                   "seed; with method='optimization' also synthesize_solid's (levels, neighborhood, iterations, ...)");
         Image img;
         std::vector<double> energy;
         {
@@ -167,8 +204,11 @@ Returns {'solid': (Z, Y, X, C) float32, 'energy': [...], 'energy_level': [...]}.
       },
       py::arg("exemplar"), py::kw_only(), py::arg("width") = 128, py::arg("height") = 128,
       py::arg("ctx") = py::none(),
-      "2D texture optimisation: exemplar -> (height, width, C) float32 image (tileable=True to tile).\n"
-      "Same options as synthesize_solid. Returns {'image': ..., 'energy': [...]}.");
+      "2D texture synthesis: exemplar -> (height, width, C) float32 image (tileable=True to tile).\n"
+      "method='coordinates' (default; Lefebvre & Hoppe 2005 in appearance space: jitter=0.25, jitter_from=8,\n"
+      "corrections=2, candidates_k=1, coherence=1, wide_below=0, appearance_window=5, appearance_dims=8,\n"
+      "coarsest_spacing=0 (auto), exhaustive=False; also tileable, max_exemplar_size, seed) or 'optimization' (the optimiser of\n"
+      "synthesize_solid, same options). Returns {'image': ..., 'energy': [...]}.");
 }
 
 }  // namespace exsynth::py_bind

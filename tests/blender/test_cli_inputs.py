@@ -164,7 +164,7 @@ def test_analogy_budget_message_names_what_the_cli_can_change(tmp_path, capsys):
 
 
 @pytest.mark.parametrize("args, message", [
-    (["image", "--width", "64", "--height", "3", "--out", "x.png"],
+    (["image", "--method", "optimization", "--width", "64", "--height", "3", "--out", "x.png"],
      "--width and --height must be 29..16384 pixels with --levels 3 (got 64x3)"),
     (["solid", "--size", "1", "--out", "x.npy"], "--size must be 29..2048 voxels with --levels 3 (got 1)"),
 ])

@@ -577,14 +577,18 @@ def test_cli_solid_bakes_onto_a_mesh(tmp_path, capsys):
 def test_cli_image_writes_a_png_of_the_requested_size(tmp_path, capsys):
     from exsynth import cli
 
-    for args, name in (([], "a.png"), (["--tileable", "--seed", "3"], "b.png")):
+    for args, name in (([], "a.png"), (["--tileable", "--seed", "3"], "b.png"),
+                       (["--method", "optimization", "--levels", "2", "--iterations", "2"], "c.png"),
+                       (["--width", "7", "--height", "5"], "d.png")):
         out = tmp_path / name
         assert cli.main(["image", "--exemplar", CRACKED, "--width", "40", "--height", "24",
-                         "--levels", "2", "--iterations", "2", *args, "--out", str(out)]) == 0
+                         *args, "--out", str(out)]) == 0
         image = bpy.data.images.load(str(out))
-        assert tuple(image.size) == (40, 24)
+        assert tuple(image.size) == ((7, 5) if name == "d.png" else (40, 24))
         assert image_pixels(image)[..., :3].std() > 0.02
-    assert "image: 40x24, tileable" in capsys.readouterr().out
+    out = capsys.readouterr().out
+    assert "image (coordinates): 40x24, tileable" in out and "image (optimization): 40x24 from" in out
+    assert "image (coordinates): 7x5 from" in out  # below the optimiser's size rule
 
 
 def test_cli_bad_arguments(tmp_path, monkeypatch, capsys):

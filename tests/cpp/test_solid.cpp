@@ -321,6 +321,7 @@ TEST(SolidErrors, OneSizeRuleForSolidsAndImages) {
   o.size = 8;
   EXPECT_EQ(synthesize_solid(ex, o).texture.nx(), 8);
   ImageSynthesisOptions io;
+  io.method = ImageMethod::Optimization;  // these tests are the optimiser's
   io.levels = 2;
   for (auto wh : {std::pair{1, 1}, std::pair{32, 1}, std::pair{14, 40}}) {
     io.width = wh.first;
@@ -358,6 +359,7 @@ TEST(Solid, HugeAndTinyExemplarValuesWork) {
       for (double e : r.energy) EXPECT_TRUE(std::isfinite(e)) << scale;
     }
     ImageSynthesisOptions io;
+    io.method = ImageMethod::Optimization;  // these tests are the optimiser's
     io.width = io.height = 24;
     io.levels = 1;
     const Image img = synthesize_image(ex, io);
@@ -400,6 +402,7 @@ TEST(SolidErrors, RefusesSizesOverTheMemoryBudget) {
 TEST(Image2D, SynthesisesTheRequestedSizeAndTiles) {
   const Image ex = disc_texture(32, 32, 3, 14);
   ImageSynthesisOptions o;
+  o.method = ImageMethod::Optimization;  // these tests are the optimiser's
   o.width = 48;
   o.height = 40;
   o.levels = 2;
@@ -539,6 +542,7 @@ TEST(Solid, ExemplarValuesAreTheExemplarsTexelsAtTheirSource) {
 TEST(Image2D, ExemplarValuesComeFromTheExemplarAndAreDeterministic) {
   const Image ex = disc_texture(32, 32, 3, 22);
   ImageSynthesisOptions o;
+  o.method = ImageMethod::Optimization;  // these tests are the optimiser's
   o.width = 40;
   o.height = 36;
   o.levels = 2;
@@ -571,6 +575,7 @@ TEST(Solid, CancelInsideTheExemplarValuesPass) {
   EXPECT_TRUE(outcome.threw_cancelled);
   EXPECT_EQ(outcome.stage_at_throw, "solid: level 2/2 exemplar values");
   ImageSynthesisOptions io;
+  io.method = ImageMethod::Optimization;  // these tests are the optimiser's
   io.width = io.height = 48;
   io.levels = 2;
   const auto image = exsynth::testing::cancel_in_stage(

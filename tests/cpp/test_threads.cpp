@@ -58,10 +58,15 @@ TEST(EightThreads, SolidAndImage) {
   opt.seed = 5;
   expect_same_on_1_and_8_threads([&] { return synthesize_solid(ex, opt).texture.values(); });
   ImageSynthesisOptions io;
+  io.method = ImageMethod::Optimization;  // these tests are the optimiser's
   io.width = io.height = 40;
   io.levels = 2;
   io.seed = 3;
   expect_same_on_1_and_8_threads([&] { return synthesize_image(ex.views[0], io).values(); });
+  ImageSynthesisOptions co;  // the coordinate method (the default)
+  co.width = co.height = 40;
+  co.seed = 3;
+  expect_same_on_1_and_8_threads([&] { return synthesize_image(ex.views[0], co).values(); });
 }
 
 TEST(EightThreads, DiffusedField) {

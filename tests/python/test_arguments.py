@@ -72,7 +72,11 @@ FUNCTIONS = {
         "exemplar_values": "bool", "tileable": "bool", "memory_budget": "budget", "seed": "seed", "ctx": "ctx"}),
     "synthesize_image": (call("synthesize_image", IMG, width=8, height=8, levels=1, iterations=1), {
         "width": ("int", 1, 16384), "height": ("int", 1, 16384), "levels": ("int", 1, 8), "r": ("real", 0, 2),
-        "exemplar_values": "bool", "memory_budget": "budget", "seed": "seed", "tileable": "bool", "ctx": "ctx"}),
+        "exemplar_values": "bool", "memory_budget": "budget", "seed": "seed", "tileable": "bool", "ctx": "ctx",
+        "method": "str", "jitter": ("real", 0, 4), "jitter_from": ("int", 1, 1024), "corrections": ("int", 0, 16),
+        "candidates_k": ("int", 1, 16), "coherence": ("real", 0, 100), "wide_below": ("int", 0, 1024),
+        "appearance_window": ("int", 1, 15), "appearance_dims": ("int", 1, 64),
+        "coarsest_spacing": ("int", 0, 1024), "exhaustive": "bool"}),
     "diffuse_direction_field": (call("diffuse_direction_field", VERTS, FACES, GIVEN), {
         "weights": "str", "seed": "seed", "ctx": "ctx"}),
     "preset_direction_field": (call("preset_direction_field", VERTS, FACES), {"preset": "str", "ctx": "ctx"}),

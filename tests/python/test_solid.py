@@ -90,7 +90,8 @@ def test_grayscale_and_two_view_mode():
 
 def test_image_synthesis_tileable():
     ex = exemplar(size=40)
-    res = _native.synthesize_image(ex, width=64, height=48, levels=2, tileable=True, seed=4)
+    res = _native.synthesize_image(ex, width=64, height=48, levels=2, tileable=True, seed=4,
+                                   method="optimization")
     img = res["image"]
     assert img.shape == (48, 64, 3)
     assert res["energy"][-1] < res["energy"][0]
@@ -221,9 +222,9 @@ def test_one_size_rule_exposed_and_stated():
         with pytest.raises(_native.InvalidInputError, match="size must be between 29 and 2048 voxels with 3 levels"):
             _native.synthesize_solid(ex, size=size)
     with pytest.raises(_native.InvalidInputError, match="width must be between 29 and 16384 pixels"):
-        _native.synthesize_image(ex, width=1, height=1)
+        _native.synthesize_image(ex, width=1, height=1, method="optimization")
     with pytest.raises(_native.InvalidInputError, match="height must be between 8 and 16384"):
-        _native.synthesize_image(ex, width=8, height=7, levels=1)
+        _native.synthesize_image(ex, width=8, height=7, levels=1, method="optimization")
     assert _native.synthesize_solid(ex, size=8, levels=1, iterations=1)["solid"].shape == (8, 8, 8, 3)
 
 
@@ -247,7 +248,7 @@ def test_exemplar_analysis_reports_progress_and_cancels():
 
     def run():
         try:
-            _native.synthesize_image(big, width=64, height=64, levels=1, ctx=ctx)
+            _native.synthesize_image(big, width=64, height=64, levels=1, ctx=ctx, method="optimization")
         except Exception as e:  # noqa: BLE001 - checked below
             errors.append(e)
 
@@ -268,10 +269,12 @@ def test_exemplar_analysis_reports_progress_and_cancels():
 def test_large_exemplar_is_analysed_at_the_working_resolution():
     big = np.asarray(Image.open(TEXTURES / "crackedground.png").convert("RGB").resize((1100, 1000), Image.BICUBIC))
     # 1100 -> 550 -> 275 <= max_exemplar_size
-    img = _native.synthesize_image(big, width=40, height=40, levels=1, iterations=1, max_exemplar_size=300)["image"]
+    img = _native.synthesize_image(big, width=40, height=40, levels=1, iterations=1, max_exemplar_size=300,
+                                   method="optimization")["image"]
     assert img.shape == (40, 40, 3)
     with pytest.raises(_native.OverBudgetError, match="1100x1000 3-channel exemplar.*the exemplar is too big"):
-        _native.synthesize_image(big, width=40, height=40, levels=1, max_exemplar_size=0, memory_budget=256 << 20)
+        _native.synthesize_image(big, width=40, height=40, levels=1, max_exemplar_size=0, memory_budget=256 << 20,
+                                 method="optimization")
 
 
 # --- quality floors (issue 10), with exsynth.quality's metrics ---------------
@@ -287,7 +290,7 @@ def test_image_is_as_crisp_as_its_exemplar(name):
     # of the upsampled coarse level persisted).
     ex = exemplar(name, size=64)
     E = quality.Exemplar(ex)
-    m = quality.image_metrics(E, _native.synthesize_image(ex, width=96, height=96, seed=7)["image"])
+    m = quality.image_metrics(E, _native.synthesize_image(ex, width=96, height=96, seed=7, method="optimization")["image"])
     assert m["sharpness"] >= 0.95 and m["contrast"] >= 0.95, m
     assert m["nn_rel"] <= 0.4, m
 
@@ -328,7 +331,7 @@ def test_exemplar_values_are_the_exemplars_texels(what):
     def run(**kw):
         if what == "solid":
             return _native.synthesize_solid(ex, size=29, seed=3, **kw)["solid"].reshape(-1, 3)
-        return _native.synthesize_image(ex, width=48, height=40, seed=3, **kw)["image"].reshape(-1, 3)
+        return _native.synthesize_image(ex, width=48, height=40, seed=3, method="optimization", **kw)["image"].reshape(-1, 3)
     out = run()
     assert not_texels(out) == 0, f"{not_texels(out)} of {len(out)} values are not exemplar texels"
     averaged = run(exemplar_values=False)

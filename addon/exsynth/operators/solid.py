@@ -206,14 +206,17 @@ class ImageJob(Job):
     iterations: int = 3
     seed: int = 0
     memory_budget: int = 0
+    method: str = "coordinates"     # or "optimization" (levels, iterations, memory_budget apply to it)
 
     label = "image"
 
     def run(self, ctx):
+        extra = {}
+        if self.method == "optimization":
+            extra = dict(levels=self.levels, iterations=self.iterations, memory_budget=self.memory_budget)
         res = _native.synthesize_image(
             self.exemplar, width=self.width, height=self.height, tileable=self.tileable,
-            levels=self.levels, iterations=self.iterations, seed=self.seed,
-            memory_budget=self.memory_budget, ctx=ctx,
+            seed=self.seed, method=self.method, ctx=ctx, **extra,
         )
         return res["image"]  # (height, width, C), row 0 at the top
 

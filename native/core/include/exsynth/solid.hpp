@@ -1,6 +1,8 @@
 #pragma once
 // Solid texture synthesis from 2D exemplars (Kopf et al. 2007, "Solid
-// Texture Synthesis from 2D Exemplars") and the same optimiser in 2D.
+// Texture Synthesis from 2D Exemplars") and the same optimiser in 2D. Images
+// default to another method, synthesis of exemplar coordinates
+// (ImageMethod::Coordinates, native/core/src/image/coordinate_synthesis.hpp).
 //
 // Global texture optimisation: the energy is the sum over voxels v and the
 // three axis-aligned slices through v of ||s_v,i - e_v,i||^r, where s_v,i is
@@ -127,13 +129,55 @@ struct TextureResult {
 TextureResult synthesize_solid(const SolidExemplars& exemplars, const SolidOptions& opt = {},
                                ExecContext* ctx = nullptr);
 
+/// How synthesize_image makes an image.
+enum class ImageMethod {
+  /// Default: synthesis of exemplar coordinates (Lefebvre & Hoppe 2005,
+  /// "Parallel Controllable Texture Synthesis", in the appearance space of
+  /// Lefebvre & Hoppe 2006); colours are looked up at the end, so every
+  /// pixel is an exemplar pixel (docs/solid.md, "2D: coordinate synthesis").
+  Coordinates,
+  Optimization,  ///< the texture optimiser above (Kopf et al. 2007 in 2D)
+};
+
+/// Options of ImageMethod::Coordinates (the optimiser ignores them; of the
+/// shared options it uses tileable, max_exemplar_size and seed).
+struct CoordinateSynthesisOptions {
+  /// Randomness r of the jitter: after upsampling, each pixel's coordinate
+  /// moves by round(h * r * U(-1, 1)) per axis at levels of spacing h >=
+  /// jitter_from (LH05's J_l). More jitter = smaller coherent patches (less
+  /// copying) but more seams (higher nn_rel); docs/solid.md has the sweep.
+  double jitter = 0.25;
+  int jitter_from = 8;           ///< finest spacing (power of two) that is still jittered
+  int corrections = 2;           ///< correction passes per level (each of 4 sub-passes)
+  /// k-coherence candidates per neighbour (1 = the coherent one only). LH05
+  /// use 2; on the 8 exemplars 2 changed no measure by more than 0.01 and
+  /// cost 3x the CPU (docs/solid.md), so 1.
+  int coherence_k = 1;
+  /// Coherence bias: a candidate that continues a neighbour's patch wins
+  /// unless another's distance is smaller by the factor (1 + coherence).
+  double coherence = 1.0;
+  /// Levels of spacing <= this compare 5 x 5 neighbourhoods of appearance
+  /// vectors instead of 3 x 3 (0 = 3 x 3 everywhere).
+  int wide_below = 0;
+  int appearance_window = 5;     ///< appearance vectors: PCA of this window's colours ...
+  int appearance_dims = 8;       ///< ... to this many dimensions (LH06: 5 x 5 -> 8)
+  /// Spacing of the coarsest level (a power of two); 0 = the largest power
+  /// of two <= a third of the exemplar's shorter edge (32 for 128^2).
+  int coarsest_spacing = 0;
+  /// Exhaustive correction (every exemplar position is a candidate): the
+  /// reference the tests compare the k-coherence search with.
+  bool exhaustive = false;
+};
+
 struct ImageSynthesisOptions : TextureOptimizationOptions {
   int width = 128;
   int height = 128;
+  ImageMethod method = ImageMethod::Coordinates;
+  CoordinateSynthesisOptions coordinates;
   ImageSynthesisOptions() { tileable = false; }
 };
 
-/// 2D texture optimisation: exemplar -> a width x height image.
+/// 2D synthesis: exemplar -> a width x height image, by `opt.method`.
 Image synthesize_image(const Image& exemplar, const ImageSynthesisOptions& opt = {}, ExecContext* ctx = nullptr,
                        std::vector<double>* energy = nullptr);
 

@@ -8,6 +8,7 @@
 
 #include "exsynth/errors.hpp"
 #include "exsynth/pyramid.hpp"
+#include "image/coordinate_synthesis.hpp"
 #include "exsynth/rng.hpp"
 #include "exsynth/sample.hpp"
 #include "exsynth/solid.hpp"
@@ -407,6 +408,7 @@ TextureResult synthesize_solid(const SolidExemplars& ex, const SolidOptions& opt
 
 Image synthesize_image(const Image& exemplar, const ImageSynthesisOptions& opt, ExecContext* ctx,
                        std::vector<double>* energy) {
+  if (opt.method == ImageMethod::Coordinates) return image::synthesize_coordinates(exemplar, opt, ctx, energy);
   check_edge("width", opt.width, kMaxImageSize, opt, "pixels");
   check_edge("height", opt.height, kMaxImageSize, opt, "pixels");
   Job job;

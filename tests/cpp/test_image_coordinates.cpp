@@ -1,0 +1,241 @@
+// 2D synthesis of exemplar coordinates (Lefebvre & Hoppe 2005 in appearance
+// space): the fast candidate search against brute-force references, the
+// distance against a direct evaluation, determinism over thread counts,
+// cancellation in every stage, every output pixel an exemplar pixel, and
+// bad options.
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+#include <tbb/global_control.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "exsynth/errors.hpp"
+#include "exsynth/solid.hpp"
+#include "image/coordinate_synthesis.hpp"
+#include "support/cancel.hpp"
+#include "support/textures.hpp"
+
+using namespace exsynth;
+using exsynth::image::Coord;
+using exsynth::image::CoordImage;
+using exsynth::image::CoordinateSolver;
+using exsynth::testing::disc_texture;
+using ::testing::HasSubstr;
+
+namespace {
+
+CoordinateSynthesisOptions plain() {
+  CoordinateSynthesisOptions o;
+  o.coherence = 0.0;  // the references below are plain minima
+  o.coarsest_spacing = 2;
+  return o;
+}
+
+/// The neighbourhood distance written out from its definition: over the
+/// 3 x 3 output neighbours inside the image (or wrapped), the squared
+/// difference between the appearance at the neighbour's coordinate and at
+/// the candidate moved by the neighbour's offset times the spacing (clamped).
+double reference_distance(const CoordinateSolver& s, const CoordImage& img, int x, int y, Coord c, int level,
+                          bool tileable) {
+  const Image& a = s.appearance(level);
+  const int h = s.spacing(level);
+  double d = 0.0;
+  for (int dy = -1; dy <= 1; ++dy)
+    for (int dx = -1; dx <= 1; ++dx) {
+      int nx = x + dx, ny = y + dy;
+      if (tileable) nx = (nx + img.width) % img.width, ny = (ny + img.height) % img.height;
+      else if (nx < 0 || ny < 0 || nx >= img.width || ny >= img.height) continue;
+      const Coord q = img.at(nx, ny);
+      const int eu = std::clamp(c.u + h * dx, 0, a.width() - 1), ev = std::clamp(c.v + h * dy, 0, a.height() - 1);
+      for (int k = 0; k < a.channels(); ++k) {
+        const double e = double(a.at(eu, ev, k)) - double(a.at(q.u, q.v, k));
+        d += e * e;
+      }
+    }
+  return d;
+}
+
+ImageSynthesisOptions small_image() {
+  ImageSynthesisOptions o;
+  o.width = 40;
+  o.height = 36;
+  o.seed = 3;
+  return o;
+}
+
+}  // namespace
+
+TEST(ImageCoordinates, DistanceMatchesItsDefinition) {
+  const Image ex = disc_texture(20, 18, 3, 31);
+  for (bool tileable : {false, true}) {
+    const CoordinateSolver s(ex, plain(), tileable, 4, nullptr, 0, 1);
+    const int level = s.levels() - 1;
+    const CoordImage img = s.initial(9, 7);
+    for (int y = 0; y < img.height; ++y)
+      for (int x = 0; x < img.width; ++x)
+        for (Coord c : {s.lowest(), s.highest(), img.at((x + 3) % 9, y)}) {
+          const double ref = reference_distance(s, img, x, y, c, level, tileable);
+          EXPECT_NEAR(s.distance(img, x, y, c, level), ref, 1e-4 * (1 + ref)) << x << "," << y;
+        }
+  }
+}
+
+TEST(ImageCoordinates, ExhaustiveCorrectionFindsTheGlobalMinimum) {
+  // Pixels of the first sub-pass (even x, even y) are decided from the
+  // state before the pass and not touched by the later sub-passes.
+  const Image ex = disc_texture(16, 16, 3, 32);
+  CoordinateSynthesisOptions o = plain();
+  o.exhaustive = true;
+  const CoordinateSolver s(ex, o, false, 5, nullptr, 0, 1);
+  const int level = s.levels() - 1;
+  const CoordImage before = s.initial(10, 8);
+  CoordImage after = before;
+  StageProgress progress(nullptr, "", 0, 1, 1);
+  s.correct(after, level, progress);
+  for (int y = 0; y < before.height; y += 2)
+    for (int x = 0; x < before.width; x += 2) {
+      double best = std::numeric_limits<double>::infinity();
+      for (int v = s.lowest().v; v <= s.highest().v; ++v)
+        for (int u = s.lowest().u; u <= s.highest().u; ++u)
+          best = std::min(best, reference_distance(s, before, x, y, {u, v}, level, false));
+      EXPECT_NEAR(reference_distance(s, before, x, y, after.at(x, y), level, false), best, 1e-4 * (1 + best));
+    }
+}
+
+TEST(ImageCoordinates, KCoherenceCorrectionTakesTheBestOfItsCandidates) {
+  const Image ex = disc_texture(24, 24, 3, 33);
+  CoordinateSynthesisOptions o = plain();
+  o.coherence_k = 3;
+  for (bool tileable : {false, true}) {
+    const CoordinateSolver s(ex, o, tileable, 6, nullptr, 0, 1);
+    const int level = s.levels() - 1;
+    const CoordImage before = s.initial(12, 10);
+    CoordImage after = before;
+    StageProgress progress(nullptr, "", 0, 1, 1);
+    s.correct(after, level, progress);
+    int moved = 0;
+    for (int y = 0; y < before.height; y += 2)
+      for (int x = 0; x < before.width; x += 2) {
+        const std::vector<Coord> cands = s.candidates(before, x, y, level);
+        ASSERT_GE(cands.size(), 2u);
+        double best = std::numeric_limits<double>::infinity();
+        for (const Coord& c : cands) best = std::min(best, reference_distance(s, before, x, y, c, level, tileable));
+        const Coord got = after.at(x, y);
+        EXPECT_NE(std::find(cands.begin(), cands.end(), got), cands.end()) << "not one of the candidates";
+        EXPECT_NEAR(reference_distance(s, before, x, y, got, level, tileable), best, 1e-4 * (1 + best));
+        moved += !(got == before.at(x, y));
+      }
+    EXPECT_GT(moved, 0);  // from a random start the pass changes something
+  }
+}
+
+TEST(ImageCoordinates, UpsamplingContinuesTheParentPatch) {
+  const Image ex = disc_texture(64, 64, 3, 34);
+  CoordinateSynthesisOptions o = plain();
+  o.coarsest_spacing = 8;
+  const CoordinateSolver s(ex, o, false, 7, nullptr, 0, 1);
+  ASSERT_EQ(s.levels(), 4);
+  const CoordImage parent = s.initial(5, 4);
+  const CoordImage child = s.upsample(parent, 9, 8, 1);  // spacing 4
+  for (int y = 0; y < child.height; ++y)
+    for (int x = 0; x < child.width; ++x) {
+      const Coord p = parent.at(x / 2, y / 2);
+      // Past the valid range a coordinate wraps to its other end (no smear of one clamped column).
+      const int nu = s.highest().u - s.lowest().u + 1, nv = s.highest().v - s.lowest().v + 1;
+      const Coord want{s.lowest().u + (p.u + 4 * (x & 1) - s.lowest().u) % nu,
+                       s.lowest().v + (p.v + 4 * (y & 1) - s.lowest().v) % nv};
+      EXPECT_TRUE(child.at(x, y) == want);
+    }
+}
+
+TEST(ImageCoordinates, SameSeedSameImageOnOneAndEightThreads) {
+  const Image ex = disc_texture(32, 32, 3, 35);
+  for (bool tileable : {false, true}) {
+    ImageSynthesisOptions o = small_image();
+    o.tileable = tileable;
+    Image one, eight;
+    {
+      tbb::global_control limit(tbb::global_control::max_allowed_parallelism, 1);
+      one = synthesize_image(ex, o);
+    }
+    {
+      tbb::global_control limit(tbb::global_control::max_allowed_parallelism, 8);
+      eight = synthesize_image(ex, o);
+    }
+    EXPECT_EQ(one.values(), eight.values());
+    o.seed = 4;
+    EXPECT_NE(synthesize_image(ex, o).values(), one.values());
+  }
+}
+
+TEST(ImageCoordinates, EveryPixelIsAnExemplarPixel) {
+  const Image ex = disc_texture(24, 20, 2, 36);
+  ImageSynthesisOptions o = small_image();
+  o.width = 7;  // below the optimiser's size rule: the coordinate method takes any size
+  o.height = 5;
+  for (int w : {7, 41}) {
+    o.width = w;
+    const Image out = synthesize_image(ex, o);
+    ASSERT_EQ(out.width(), w);
+    ASSERT_EQ(out.height(), 5);
+    for (std::size_t p = 0; p < out.pixel_count(); ++p) {
+      bool found = false;
+      for (std::size_t q = 0; q < ex.pixel_count() && !found; ++q)
+        found = out.data()[p * 2] == ex.data()[q * 2] && out.data()[p * 2 + 1] == ex.data()[q * 2 + 1];
+      ASSERT_TRUE(found) << "pixel " << p;
+    }
+  }
+}
+
+TEST(ImageCoordinates, TinyAndHugeValuedExemplarsWork) {
+  for (float scale : {1e-30f, 1e30f}) {
+    Image ex = disc_texture(16, 16, 1, 37);
+    for (float& v : ex.values()) v *= scale;
+    ImageSynthesisOptions o = small_image();
+    const Image out = synthesize_image(ex, o);
+    float lo = out.values()[0], hi = lo;
+    for (float v : out.values()) lo = std::min(lo, v), hi = std::max(hi, v);
+    EXPECT_GT(hi, lo);  // structure, not one repeated pixel
+  }
+}
+
+TEST(ImageCoordinates, CancelInEveryStage) {
+  const Image ex = disc_texture(32, 32, 3, 38);
+  ImageSynthesisOptions o = small_image();
+  const auto job = [&](ExecContext* ctx) { synthesize_image(ex, o, ctx); };
+  const auto log = exsynth::testing::stages_of(job);
+  ASSERT_GE(log.names.size(), 4u);
+  EXPECT_NEAR(log.final_progress, 1.0, 1e-9);
+  for (const std::string& stage : log.names) {
+    const auto outcome = exsynth::testing::cancel_in_stage(job, stage);
+    EXPECT_TRUE(outcome.threw_cancelled) << stage;
+    EXPECT_EQ(outcome.stage_at_throw, stage);
+  }
+  EXPECT_THAT(log.names.back(), HasSubstr("(coordinates)"));
+}
+
+TEST(ImageCoordinates, BadOptionsNameTheOption) {
+  const Image ex = disc_texture(16, 16, 3, 39);
+  auto message = [&](auto change) {
+    ImageSynthesisOptions o = small_image();
+    change(o);
+    try {
+      synthesize_image(ex, o);
+    } catch (const InvalidInput& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  EXPECT_THAT(message([](auto& o) { o.coordinates.jitter = -1; }), HasSubstr("jitter must be"));
+  EXPECT_THAT(message([](auto& o) { o.coordinates.jitter_from = 3; }), HasSubstr("jitter_from must be a power of two"));
+  EXPECT_THAT(message([](auto& o) { o.coordinates.coherence_k = 0; }), HasSubstr("coherence_k must be"));
+  EXPECT_THAT(message([](auto& o) { o.coordinates.appearance_window = 4; }), HasSubstr("appearance_window must be odd"));
+  EXPECT_THAT(message([](auto& o) { o.coordinates.coarsest_spacing = 6; }), HasSubstr("coarsest_spacing must be"));
+  EXPECT_THAT(message([](auto& o) { o.coordinates.coherence = -1; }), HasSubstr("coherence must be"));
+  EXPECT_THAT(message([](auto& o) { o.width = 0; }), HasSubstr("width must be between 1 and"));
+  Image bad = ex;
+  bad.at(3, 4, 1) = std::nanf("");
+  EXPECT_THROW(synthesize_image(bad, small_image()), InvalidInput);
+}
