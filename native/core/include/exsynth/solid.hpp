@@ -13,6 +13,7 @@
 #include <array>
 #include <cstddef>
 #include <cstdint>
+#include <string>
 #include <vector>
 
 #include "exsynth/exec_context.hpp"
@@ -109,10 +110,40 @@ struct SolidExemplars {
   Volume constraint;
 };
 
+/// How a solid is synthesized.
+enum class SolidMethod {
+  /// Kopf et al. 2007: global texture optimisation of voxel values (above).
+  Optimization,
+  /// Dong et al. 2008 "Lazy Solid Texture Synthesis": every voxel holds
+  /// exemplar coordinates (a triple of texels whose crossbars agree, one per
+  /// view), synthesized coarse to fine by coordinate upsampling and
+  /// correction passes among k-coherence candidates in appearance space
+  /// (PCA of 5x5 neighbourhoods); colours are looked up at the end. Uses
+  /// levels, iterations (correction passes; coarsest 2x, finest as
+  /// finest_iterations), coherence_k, pca_variance / max_pca_dims (at most
+  /// kCoordinateFeatureDims), max_exemplar_size, tileable, memory_budget and
+  /// seed; the optimiser's other options do not apply. No constraint volume
+  /// and no feature channel yet. See docs/solid.md.
+  Coordinates,
+};
+/// Appearance-space feature window and largest feature dimension of SolidMethod::Coordinates.
+constexpr int kCoordinateWindow = 5;
+constexpr int kCoordinateFeatureDims = 8;
+
+/// The method names the bindings, add-on and CLI accept, in enum order
+/// ("optimization", "coordinates"), and the default's.
+const std::vector<std::string>& solid_method_names();
+const char* solid_method_name(SolidMethod m);
+/// Parses a name of solid_method_names(); InvalidInput naming them otherwise.
+SolidMethod solid_method_from_name(const std::string& name);
+
 struct SolidOptions : TextureOptimizationOptions {
   int size = 64;  ///< output edge length in voxels (size^3)
+  SolidMethod method = SolidMethod::Optimization;
   SolidOptions() { finest_iterations = -1; }
 };
+/// The default method's name (SolidOptions{}.method).
+const char* default_solid_method_name();
 
 struct TextureResult {
   Volume texture;                      ///< the solid (size^3 x C), or the image as a (W, H, 1) volume
