@@ -120,7 +120,7 @@ enum class SolidMethod {
   /// correction passes among k-coherence candidates in appearance space
   /// (PCA of 5x5 neighbourhoods); colours are looked up at the end. Uses
   /// levels, iterations (correction passes; coarsest 2x, finest as
-  /// finest_iterations), coherence_k, pca_variance / max_pca_dims (at most
+  /// finest_iterations), coordinate_coherence_k, pca_variance / max_pca_dims (at most
   /// kCoordinateFeatureDims), max_exemplar_size, tileable, memory_budget and
   /// seed; the optimiser's other options do not apply. No constraint volume
   /// and no feature channel yet. See docs/solid.md.
@@ -140,6 +140,10 @@ SolidMethod solid_method_from_name(const std::string& name);
 struct SolidOptions : TextureOptimizationOptions {
   int size = 64;  ///< output edge length in voxels (size^3)
   SolidMethod method = SolidMethod::Optimization;
+  /// Coordinates: k-coherence candidates per neighbour's texel (its most
+  /// similar texels). 1 measured as good as 4 at half the time (64^3,
+  /// crackedground / stone33; docs/solid.md). 0 = the neighbours' own only.
+  int coordinate_coherence_k = 1;
   SolidOptions() { finest_iterations = -1; }
 };
 /// The default method's name (SolidOptions{}.method).

@@ -73,6 +73,8 @@ TextureResult synthesize_coordinates(const std::array<const Image*, 3>& view_ima
   if (opt.feature_weight > 0)
     throw InvalidInput("method 'coordinates' has no feature-distance channel; set feature_weight=0 or use "
                        "method='optimization'");
+  if (opt.coordinate_coherence_k < 0 || opt.coordinate_coherence_k > 16)
+    throw InvalidInput("coordinate_coherence_k must be between 0 and 16, got " + std::to_string(opt.coordinate_coherence_k));
   const int L = opt.levels;
   StageProgress prepare(ctx, "solid: preparing the exemplars", 0.0, 0.0, 1);
 
@@ -126,7 +128,7 @@ TextureResult synthesize_coordinates(const std::array<const Image*, 3>& view_ima
     double bytes = voxels * (12.0 * 1.25 + 4.0 * channels);
     for (const Image& w : working)
       bytes += double(w.pixel_count()) *
-               (double(kCoordinateWindow) * kCoordinateWindow * channels + kCoordinateFeatureDims + opt.coherence_k +
+               (double(kCoordinateWindow) * kCoordinateWindow * channels + kCoordinateFeatureDims + opt.coordinate_coherence_k +
                 2.0 * (2 * kCrossbarHalf + 1) * channels + 3.0 * 4 * kTriplesPerTexel) * 4.0 * 1.5;
     check_memory_budget(bytes, opt.memory_budget, "synthesizing a " + std::to_string(opt.size) + "^3 solid",
                         "lower the size, the exemplar's size or max_exemplar_size, or raise the memory budget");
@@ -164,7 +166,7 @@ TextureResult synthesize_coordinates(const std::array<const Image*, 3>& view_ima
     std::vector<std::unique_ptr<ExemplarIndex>> index;
     for (std::size_t e = 0; e < pyramids.size(); ++e)
       index.push_back(std::make_unique<ExemplarIndex>(
-          pyramids[e][pyr], kCoordinateWindow, opt.pca_variance, feature_dims, std::max(opt.coherence_k, 1),
+          pyramids[e][pyr], kCoordinateWindow, opt.pca_variance, feature_dims, std::max(opt.coordinate_coherence_k, 1),
           opt.histogram_bins, lo, hi, ctx, stage + " exemplar analysis", a0 + (a1 - a0) * double(e) / pyramids.size(),
           a0 + (a1 - a0) * double(e + 1) / pyramids.size()));
     std::array<const ExemplarIndex*, 3> views{};
@@ -174,7 +176,7 @@ TextureResult synthesize_coordinates(const std::array<const Image*, 3>& view_ima
 
     const int passes = rounds(opt, l, L, edge[l]);
     auto solver = std::make_unique<CoordinateSolver>(std::array<int, 3>{edge[l], edge[l], edge[l]}, views, *table,
-                                                     opt.coherence_k, opt.tileable, hash_index(opt.seed, std::uint64_t(l), 0xC0DE));
+                                                     opt.coordinate_coherence_k, opt.tileable, hash_index(opt.seed, std::uint64_t(l), 0xC0DE));
     StageProgress progress(ctx, l == 0 ? stage + " initialise" : stage + " upsample", a2, p1,
                            std::size_t(passes + 1) * solver->units() + (l == L - 1 ? solver->units() : 0));
     if (l == 0) solver->initialize(progress);
