@@ -57,11 +57,17 @@ void check_exemplar(const Image& img, int view, int channels) {
                          std::to_string(i / img.channels() / img.width()) + "); fix or clamp the image first");
 }
 
+// finest_iterations = -1: this many correction passes at the finest level
+// once it is kAutoFinestFrom voxels across. 1 instead of 2 at 64^3
+// (crackedground / stone33, seed 7): CPU 9.9 / 11.4 -> 7.8 / 7.8 s,
+// sharpness 0.86 / 0.74 -> 0.87 / 0.77, hist_emd 2.94 / 10.8 -> 2.89 / 9.9.
+constexpr int kAutoFinestPasses = 1;
+
 int rounds(const SolidOptions& opt, int level, int levels, int edge) {
   if (level == 0) return 2 * opt.iterations;  // random start: more passes, and cheap
   if (level < levels - 1 || opt.finest_iterations == 0) return opt.iterations;
   if (opt.finest_iterations > 0) return opt.finest_iterations;
-  return edge >= kAutoFinestFrom ? std::min(kAutoFinestIterations, opt.iterations) : opt.iterations;
+  return edge >= kAutoFinestFrom ? std::min(kAutoFinestPasses, opt.iterations) : opt.iterations;
 }
 
 }  // namespace
