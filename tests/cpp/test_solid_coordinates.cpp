@@ -143,7 +143,8 @@ TEST(SolidCoordinates, TwoViewsAndPerViewExemplars) {
 
 TEST(SolidCoordinates, CancelInEveryStage) {
   const Image ex = disc_texture(32, 32, 3, 14);
-  const SolidOptions o = coordinate_options();
+  SolidOptions o = coordinate_options();
+  o.coordinate_coherence_k = 1;  // with the k-coherence sets' stage (the default 0 skips it)
   const exsynth::testing::Job job = [&](ExecContext* ctx) { synthesize_solid(one_exemplar(ex), o, ctx); };
   const auto log = exsynth::testing::stages_of(job);
   EXPECT_DOUBLE_EQ(log.final_progress, 1.0);

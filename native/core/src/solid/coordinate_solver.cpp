@@ -138,6 +138,7 @@ float CoordinateSolver::correct_voxel(const std::array<int, 3>& p, std::vector<T
         targets[i][a * 2 + s] = {feature(i, there), du, dv};
         const std::int32_t q = shift(i, there, -du, -dv);
         for (int r = 0; r < table_.per_texel(); ++r) add(table_.of(i, q)[r]);
+        if (k_ == 0) continue;
         const std::int32_t* similar = views_[i]->similar(q);
         for (int k = 0; k < k_; ++k)
           if (similar[k] >= 0) add(table_.of(i, similar[k])[0]);

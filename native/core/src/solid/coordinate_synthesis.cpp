@@ -40,7 +40,7 @@ namespace {
 // Crossbar lines of 7 texels; 2 triples kept per texel, from the 3 x 3 best
 // line matches in the two other views.
 constexpr int kCrossbarHalf = 3;
-constexpr int kTriplesPerTexel = 2;
+constexpr int kTriplesPerTexel = 1;
 constexpr int kLineMatches = 3;
 
 void check_exemplar(const Image& img, int view, int channels) {
@@ -172,7 +172,7 @@ TextureResult synthesize_coordinates(const std::array<const Image*, 3>& view_ima
     std::vector<std::unique_ptr<ExemplarIndex>> index;
     for (std::size_t e = 0; e < pyramids.size(); ++e)
       index.push_back(std::make_unique<ExemplarIndex>(
-          pyramids[e][pyr], kCoordinateWindow, opt.pca_variance, feature_dims, std::max(opt.coordinate_coherence_k, 1),
+          pyramids[e][pyr], kCoordinateWindow, opt.pca_variance, feature_dims, opt.coordinate_coherence_k,
           opt.histogram_bins, lo, hi, ctx, stage + " exemplar analysis", a0 + (a1 - a0) * double(e) / pyramids.size(),
           a0 + (a1 - a0) * double(e + 1) / pyramids.size()));
     std::array<const ExemplarIndex*, 3> views{};
