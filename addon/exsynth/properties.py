@@ -19,9 +19,10 @@ SOLID_DEFAULT_LEVELS = 3
 # The engine's solid methods (_native.SOLID_METHODS); the enum's identifiers
 # are the names upper-cased, the job passes them back lower-cased.
 _SOLID_METHOD_TEXT = {
-    "optimization": ("Optimization", "Texture optimisation of voxel values (Kopf et al. 2007)"),
+    "optimization": ("Optimization", "Texture optimisation of voxel values (Kopf et al. 2007): softer, takes "
+                     "the Python API's constraint volume"),
     "coordinates": ("Coordinates", "Exemplar coordinates with crossbar candidates (Dong et al. 2008): every "
-                    "voxel is a texel of the exemplar; experimental, slower, see docs/solid.md"),
+                    "voxel is a texel of the exemplar (crisper, faster)"),
 }
 SOLID_METHOD_ITEMS = tuple((m.upper(), *_SOLID_METHOD_TEXT.get(m, (m.title(), m))) for m in _native.SOLID_METHODS)
 

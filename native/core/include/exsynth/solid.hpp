@@ -139,7 +139,11 @@ SolidMethod solid_method_from_name(const std::string& name);
 
 struct SolidOptions : TextureOptimizationOptions {
   int size = 64;  ///< output edge length in voxels (size^3)
-  SolidMethod method = SolidMethod::Optimization;
+  /// The default since issue 10's fourth pass: on the 8 exemplars of
+  /// bench/bench_quality.py at 64^3 it meets 14 of the 32 per-exemplar
+  /// targets against the optimiser's 9, in about half the optimiser's CPU at
+  /// 128^3 (docs/solid.md).
+  SolidMethod method = SolidMethod::Coordinates;
   /// Coordinates: k-coherence candidates per neighbour's texel (its most
   /// similar texels). 0 = the neighbours' own texels only: measured as good
   /// as 1 and 4, and faster (64^3, crackedground / stone33 / brick; docs/solid.md).
