@@ -602,7 +602,8 @@ def test_cli_bad_arguments(tmp_path, monkeypatch, capsys):
         (["--exemplar", CRACKED, "--out", "s.npy", "--size", "0"], 2, "--size must be > 0"),
         (["--exemplar", str(tiny), *FAST, "--method", "optimization", "--out", "s.npy"], 1,
          "smaller than the 8x8 neighbourhood"),
-        (["--exemplar", str(tiny), *FAST, "--out", "s.npy"], 1, "too small for method 'coordinates'"),
+        (["--exemplar", str(tiny), *FAST, "--method", "coordinates", "--out", "s.npy"], 1,
+         "too small for method 'coordinates'"),
     ]
     for args, code, message in cases:
         assert cli.main(["solid", *args]) == code, args

@@ -139,11 +139,11 @@ SolidMethod solid_method_from_name(const std::string& name);
 
 struct SolidOptions : TextureOptimizationOptions {
   int size = 64;  ///< output edge length in voxels (size^3)
-  /// The default since issue 10's fourth pass: on the 8 exemplars of
-  /// bench/bench_quality.py at 64^3 it meets 14 of the 32 per-exemplar
-  /// targets against the optimiser's 9, in about half the optimiser's CPU at
-  /// 128^3 (docs/solid.md).
-  SolidMethod method = SolidMethod::Coordinates;
+  /// Coordinates meets more of issue 10's slice targets (14 of 32 against
+  /// 9 at 64^3) in about half the CPU at 128^3, but the demo's cow (oblique
+  /// cuts) shows streaks where a view's texel is extruded along its axis, so
+  /// the optimiser stays the default (docs/solid.md, fourth pass).
+  SolidMethod method = SolidMethod::Optimization;
   /// Coordinates: k-coherence candidates per neighbour's texel (its most
   /// similar texels). 0 = the neighbours' own texels only: measured as good
   /// as 1 and 4, and faster (64^3, crackedground / stone33 / brick; docs/solid.md).
