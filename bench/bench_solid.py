@@ -4,7 +4,9 @@
 Each case runs in its own process (so its peak RSS is its own) and prints
 one table row: wall time, peak memory and the final texture energy (mean
 |s - e|^0.8 per matched 8x8 neighbourhood, lower = closer to the exemplar),
-so speed and quality are read together.
+so speed and quality are read together. The coordinates rows' energy is
+another unit (the last correction pass's mean crossbar cost in appearance
+space); "cpu s" is the whole process's user+sys.
 
 usage: bench_solid.py --build BUILD_DIR [--cases solid128,solid256,image256,coord64,coord128]
 """
