@@ -44,8 +44,6 @@ class CoordinateSolver {
   const std::vector<Triple>& coordinates() const { return coords_; }
   /// Mean over voxels of the best candidate's cost after the last pass.
   double energy() const { return energy_; }
-  /// Weight of the crossbar consistency term (test hook for tuning).
-  void set_consistency(float w) { consistency_ = w; }
 
  private:
   std::size_t voxel(int x, int y, int z) const { return (std::size_t(z) * dims_[1] + y) * dims_[0] + x; }
@@ -66,7 +64,7 @@ class CoordinateSolver {
   int k_;
   // Weight of the crossbar consistency against the neighbourhood match: 1
   // gave crisper 32^3 stone33 slices than 4 or 16 (docs/solid.md).
-  float consistency_ = 1.0f;
+  const float consistency_ = 1.0f;
   bool wrap_;
   std::uint64_t seed_;
   std::array<const float*, 3> features_{};
