@@ -42,6 +42,7 @@ EXEMPLARS = {  # name: source
     "slate": os.path.join(GIMP, "Stone", "slate.pat"),
     "brownground": os.path.join(ASSIMP, "IRRMesh", "brownground_1-1.jpg"),
 }
+SOLID_ONLY = ("method", "coordinate_coherence_k")  # options synthesize_image does not take
 KEYS = ("nn_rel", "sharpness", "contrast", "hist_emd", "copy_rate", "max_copy_frac")
 
 
@@ -91,6 +92,7 @@ def main(argv=None):
     ap.add_argument("--full", action="store_true", help="also 128^3 solids (slower)")
     ap.add_argument("--exemplars", default=",".join(EXEMPLARS))
     ap.add_argument("--no-peers", action="store_true")
+    ap.add_argument("--solids-only", action="store_true", help="only the solids (no images, peers or speed)")
     ap.add_argument("--options", default="", help="extra engine options, e.g. 'coherent_upsampling=False'")
     args = ap.parse_args(argv)
     sys.path.insert(0, os.path.join(args.build, "addon"))
@@ -100,8 +102,10 @@ def main(argv=None):
     peers = not args.no_peers and shutil.which("gmic") is not None
     names = args.exemplars.split(",")
     tmp = tempfile.mkdtemp(prefix="exsynth_bench_")
+    method = opts.get("method", _native.SOLID_DEFAULT_METHOD)
+    image_opts = {k: v for k, v in opts.items() if k not in SOLID_ONLY}
     print(f"machine: {os.cpu_count()} cores; 128^2 exemplars, {args.options or 'default options'}, seed 7; "
-          "solids: mean of x/y/z slices")
+          f"solids: mean of x/y/z slices, method {method}")
     print(f"image method: {opts.get('method', 'coordinates')} (synthesize_image's default: coordinates); "
           f"load average at start {os.getloadavg()[0]:.1f}")
     header = f"{'output':<44} " + " ".join(f"{k:>9}" for k in KEYS)
@@ -118,9 +122,10 @@ def main(argv=None):
         if args.full:
             cases.append(("solid 128^3", lambda: quality.volume_metrics(
                 E, _native.synthesize_solid(ex, size=128, seed=7, **opts)["solid"], slices=4)["mean"]))
-        cases.append(("image 256^2", lambda: quality.image_metrics(
-            E, _native.synthesize_image(ex, width=256, height=256, seed=7, **opts)["image"])))
-        if peers:
+        if not args.solids_only:
+            cases.append(("image 256^2", lambda: quality.image_metrics(
+                E, _native.synthesize_image(ex, width=256, height=256, seed=7, **image_opts)["image"])))
+        if peers and not args.solids_only:
             cases.append(("G'MIC matchpatch 256^2 (peer)", lambda: quality.image_metrics(
                 E, gmic_image(ex_png, os.path.join(tmp, name + "_gmic.png")))))
         for label, run in cases:
@@ -134,6 +139,8 @@ def main(argv=None):
                   {k: (max if k in ("nn_rel", "hist_emd", "copy_rate", "max_copy_frac") else min)(m[k] for m in ms)
                    for k in KEYS}))
 
+    if args.solids_only:
+        return 0
     print()
     print("speed (whole process, same run, alternating; median of 3)")
     env = dict(os.environ, PYTHONPATH=os.path.join(args.build, "addon"))
@@ -153,8 +160,9 @@ def main(argv=None):
               f"   (exsynth / gmic: wall {ow / tw:.2f}, CPU {oc / tc:.2f}; load {os.getloadavg()[0]:.1f})")
     ex = exemplar("crackedground")
     t = time.perf_counter()
-    _native.synthesize_solid(ex, size=128, seed=7)
-    print(f"  solid 128^3 RGB (in process)                    {time.perf_counter() - t:6.2f} s")
+    solid_opts = {"method": method}
+    _native.synthesize_solid(ex, size=128, seed=7, **solid_opts)
+    print(f"  solid 128^3 RGB, method {method} (in process)   {time.perf_counter() - t:6.2f} s")
     shutil.rmtree(tmp, ignore_errors=True)
     return 0
 

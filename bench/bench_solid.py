@@ -4,9 +4,11 @@
 Each case runs in its own process (so its peak RSS is its own) and prints
 one table row: wall time, peak memory and the final texture energy (mean
 |s - e|^0.8 per matched 8x8 neighbourhood, lower = closer to the exemplar),
-so speed and quality are read together.
+so speed and quality are read together. The coordinates rows' energy is
+another unit (the last correction pass's mean crossbar cost in appearance
+space); "cpu s" is the whole process's user+sys.
 
-usage: bench_solid.py --build BUILD_DIR [--cases solid128,solid256,image256]
+usage: bench_solid.py --build BUILD_DIR [--cases solid128,solid256,image256,coord64,coord128]
 """
 import argparse
 import json
@@ -22,7 +24,12 @@ CASES = {
     "solid128": ("solid 128^3 RGB, 3 levels", "res = _native.synthesize_solid(ex, size=128, levels=3, seed=1)"),
     "solid256": ("solid 256^3 RGB, 3 levels", "res = _native.synthesize_solid(ex, size=256, levels=3, seed=1)"),
     "image256": ("image 128^2 -> 256^2, 3 levels", "res = _native.synthesize_image(ex, width=256, height=256, seed=1)"),
+    # method="coordinates" (exemplar coordinates; the solid rows above use the default method)
+    "coord64": ("solid 64^3 RGB, coordinates", "res = _native.synthesize_solid(ex, size=64, seed=1, method='coordinates')"),
+    "coord128": ("solid 128^3 RGB, coordinates", "res = _native.synthesize_solid(ex, size=128, seed=1, method='coordinates')"),
 }
+DEFAULT_CASES = "solid128,solid256,image256"
+
 
 CHILD = """
 import json, sys, time
@@ -33,7 +40,9 @@ ex = np.asarray(Image.open(sys.argv[1]).convert("RGB"))
 t = time.perf_counter()
 {stmt}
 dt = time.perf_counter() - t
-print(json.dumps({{"seconds": dt, "energy": res["energy"][-1]}}))
+import resource
+r = resource.getrusage(resource.RUSAGE_SELF)
+print(json.dumps({{"seconds": dt, "energy": res["energy"][-1], "cpu": r.ru_utime + r.ru_stime}}))
 """
 
 
@@ -51,16 +60,19 @@ def run_case(build, stmt):
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__)
     ap.add_argument("--build", required=True)
-    ap.add_argument("--cases", default=",".join(CASES))
+    ap.add_argument("--cases", default=DEFAULT_CASES, help=f"comma-separated, of {', '.join(CASES)}")
     args = ap.parse_args(argv)
-    print(f"machine: {os.cpu_count()} cores; exemplar {os.path.relpath(EXEMPLAR, ROOT)}; one process per row")
-    header = f"{'case':<34} {'seconds':>8} {'peak RSS':>10} {'energy':>8}"
+    sys.path.insert(0, os.path.join(args.build, "addon"))
+    from exsynth import _native
+    print(f"machine: {os.cpu_count()} cores, load {os.getloadavg()[0]:.1f}; exemplar {os.path.relpath(EXEMPLAR, ROOT)}; "
+          f"one process per row; solid method: {_native.SOLID_DEFAULT_METHOD} unless the row says otherwise")
+    header = f"{'case':<34} {'seconds':>8} {'cpu s':>7} {'peak RSS':>10} {'energy':>8}"
     print(header)
     print("-" * len(header))
     for name in args.cases.split(","):
         desc, stmt = CASES[name]
         r, rss = run_case(args.build, stmt)
-        print(f"{desc:<34} {r['seconds']:>8.2f} {rss:>7.0f}MiB {r['energy']:>8.3f}")
+        print(f"{desc:<34} {r['seconds']:>8.2f} {r['cpu']:>7.2f} {rss:>7.0f}MiB {r['energy']:>8.3f}")
     return 0
 
 

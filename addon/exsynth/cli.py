@@ -167,6 +167,9 @@ def _parser():
                    help=".vdb (grid color, + alpha with --alpha) or .npy ((Z, Y, X, C) float32)")
     p.add_argument("--levels", type=_int, default=3, help="coarse-to-fine levels (default 3)")
     p.add_argument("--iterations", type=_int, default=3, help="optimisation rounds per level (default 3)")
+    p.add_argument("--method", choices=_native.SOLID_METHODS, default=_native.SOLID_DEFAULT_METHOD,
+                   help="optimization (Kopf et al. 2007) or coordinates (exemplar coordinates, Dong et al. 2008: "
+                   "crisper slices, streaks on oblique cuts) (default %(default)s)")
     p.add_argument("--seed", type=_seed, default=0, help="random seed (default 0)")
     p.add_argument("--alpha", action="store_true", help="synthesize the exemplars' alpha as a 4th channel")
     p.add_argument("--scale", type=_finite, default=0.0,
@@ -509,7 +512,7 @@ def _run_solid(args):
     job = solid_ops.SolidJob(
         name=solid_ops.exemplar_name(images[0]), exemplar=exemplar, exemplar_y=exemplar_y,
         exemplar_z=exemplar_z, size=args.size, levels=args.levels, iterations=args.iterations,
-        scale=scale, seed=args.seed, memory_budget=int(args.memory_budget * GIB), encoding=encoding,
+        method=args.method, scale=scale, seed=args.seed, memory_budget=int(args.memory_budget * GIB), encoding=encoding,
         anchor=anchor, targets=targets, bake=solid_ops.BakeOptions(args.bake_size),
     )
     result, seconds = _run_job(job, "solid")

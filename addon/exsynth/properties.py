@@ -16,6 +16,16 @@ GIB = 1 << 30
 # operator checks the pair (operators/solid.py check_size).
 SOLID_DEFAULT_LEVELS = 3
 
+# The engine's solid methods (_native.SOLID_METHODS); the enum's identifiers
+# are the names upper-cased, the job passes them back lower-cased.
+_SOLID_METHOD_TEXT = {
+    "optimization": ("Optimization", "Texture optimisation of voxel values (Kopf et al. 2007): softer, takes "
+                     "the Python API's constraint volume"),
+    "coordinates": ("Coordinates", "Exemplar coordinates with crossbar candidates (Dong et al. 2008): every "
+                    "voxel is a texel of the exemplar: crisper slices, faster, but streaks on oblique cuts"),
+}
+SOLID_METHOD_ITEMS = tuple((m.upper(), *_SOLID_METHOD_TEXT.get(m, (m.title(), m))) for m in _native.SOLID_METHODS)
+
 # The direction-field presets (Direction Field and Geometric Texture).
 FIELD_PRESET_ITEMS = (
     ('AROUND_AXIS', "Around Axis", "Circles around the axis through the mesh's centre"),
@@ -108,6 +118,12 @@ class ExSynthSettings(bpy.types.PropertyGroup):
         name="Iterations",
         description="Optimisation rounds per level (more: closer to the exemplar, slower)",
         default=3, min=1, max=20,
+    )
+    solid_method: EnumProperty(
+        name="Method",
+        description="How the solid is synthesized",
+        items=SOLID_METHOD_ITEMS,
+        default=_native.SOLID_DEFAULT_METHOD.upper(),
     )
     solid_scale: FloatProperty(
         name="Scale",

@@ -125,6 +125,8 @@ void bind_solid(py::module_& m) {
   m.attr("SOLID_MAX_SIZE") = kMaxSolidSize;
   m.attr("IMAGE_MAX_SIZE") = kMaxImageSize;
   m.attr("DEFAULT_MAX_EXEMPLAR_SIZE") = kDefaultMaxExemplarSize;
+  m.attr("SOLID_METHODS") = py::tuple(py::cast(solid_method_names()));
+  m.attr("SOLID_DEFAULT_METHOD") = default_solid_method_name();
   m.def(
       "synthesize_solid",
       [](const ArrayArg& exemplar, const OptionalArrayArg& exemplar_y, const OptionalArrayArg& exemplar_z,
@@ -146,7 +148,16 @@ void bind_solid(py::module_& m) {
         }
         SolidOptions opt;
         opt.size = int_arg(size, "size", 1, 2048, "voxels per edge");
-        set_common(opt, kw);
+        py::kwargs common;  // method is the solid's own; the rest is shared with synthesize_image
+        for (auto item : kw) {
+          if (std::string(py::str(item.first)) == "method")
+            opt.method = solid_method_from_name(string_arg(item.second, "method", "'optimization' or 'coordinates'"));
+          else if (std::string(py::str(item.first)) == "coordinate_coherence_k")
+            opt.coordinate_coherence_k = int_arg(item.second, "coordinate_coherence_k", 0, 16);
+          else
+            common[item.first] = item.second;
+        }
+        set_common(opt, common);
         TextureResult r;
         {
           py::gil_scoped_release release;
@@ -174,6 +185,9 @@ search='kcoherence'|'kdtree'|'exact', coherence_k=4, random_candidates=2, ann_ep
 ((1 + excess)^-strength re-weighting; 1 = gentle),
 mean_shift=False, coherent_upsampling=True, exemplar_values=True, feature_weight=0 (> 0: feature-distance channel), tileable=True,
 max_exemplar_size=256 (working resolution: larger exemplars are halved until they fit; 0 = never),
+method=SOLID_DEFAULT_METHOD ('optimization': Kopf et al. 2007; 'coordinates': exemplar coordinates after
+Dong et al. 2008, which uses levels, iterations, finest_iterations, coordinate_coherence_k=1 (0..16), pca_variance, max_pca_dims,
+max_exemplar_size, tileable, memory_budget and seed, and takes no constraint),
 memory_budget=0 (default), seed=0. size: min_texture_size(levels, neighborhood) .. SOLID_MAX_SIZE.
 Returns {'solid': (Z, Y, X, C) float32, 'energy': [...], 'energy_level': [...]}.)doc");
 

@@ -65,6 +65,7 @@ def exemplar():
     image = bpy.data.images.load(os.path.join(TEXTURES, "crackedground.png"))
     settings = bpy.context.scene.exsynth
     settings.solid_exemplar = image
+    settings.solid_method = 'OPTIMIZATION'  # the optimiser's tests; the method's own tests set it
     settings.solid_size = 16
     settings.solid_levels = 2
     settings.solid_iterations = 2

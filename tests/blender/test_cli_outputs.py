@@ -130,3 +130,17 @@ def test_ctrl_c_cancels_the_job_and_writes_nothing(tmp_path):
     assert "interrupted (Ctrl-C); nothing was written" in err
     assert "Traceback" not in err
     assert os.listdir(tmp_path) == []
+
+
+def test_solid_method_coordinates_and_a_bad_method(tmp_path, capsys):
+    out = tmp_path / "s.npy"
+    code, err = run(capsys, "solid", "--exemplar", CRACKED, "--size", "16", "--levels", "2", "--iterations", "1",
+                    "--method", "coordinates", "--out", str(out))
+    assert code == 0, err
+    solid = np.load(out)
+    assert solid.shape == (16, 16, 16, 3) and solid.std(axis=(0, 1, 2)).min() > 0.02
+    code, err = run(capsys, "solid", "--exemplar", CRACKED, "--size", "16", "--method", "lazy",
+                    "--out", str(tmp_path / "t.npy"))
+    assert code == 2
+    assert "--method" in err and "'optimization'" in err and "'coordinates'" in err
+    assert not (tmp_path / "t.npy").exists()

@@ -604,7 +604,10 @@ def test_cli_bad_arguments(tmp_path, monkeypatch, capsys):
         (["--exemplar", CRACKED, "--out", "s.npy", "--mesh", COW_OBJ], 2,
          "--mesh and --bake-out go together"),
         (["--exemplar", CRACKED, "--out", "s.npy", "--size", "0"], 2, "--size must be > 0"),
-        (["--exemplar", str(tiny), *FAST, "--out", "s.npy"], 1, "smaller than the 8x8 neighbourhood"),
+        (["--exemplar", str(tiny), *FAST, "--method", "optimization", "--out", "s.npy"], 1,
+         "smaller than the 8x8 neighbourhood"),
+        (["--exemplar", str(tiny), *FAST, "--method", "coordinates", "--out", "s.npy"], 1,
+         "too small for method 'coordinates'"),
     ]
     for args, code, message in cases:
         assert cli.main(["solid", *args]) == code, args
@@ -612,3 +615,29 @@ def test_cli_bad_arguments(tmp_path, monkeypatch, capsys):
     assert cli.main(["image", "--exemplar", CRACKED, "--width", "0", "--height", "8", "--out", "x.png"]) == 2
     assert "--width and --height must be > 0" in capsys.readouterr().err
     assert not any(tmp_path.glob("s.*")) and not (tmp_path / "x.png").exists()
+
+
+# ---- method (the core's names) ---------------------------------------------------------------
+def test_method_setting_lists_the_cores_methods_and_default():
+    rna = settings().bl_rna.properties["solid_method"]
+    assert [item.identifier.lower() for item in rna.enum_items] == list(_native.SOLID_METHODS)
+    assert settings().solid_method.lower() == _native.SOLID_DEFAULT_METHOD
+
+
+def test_coordinates_method_makes_a_solid_of_exemplar_texels(cow, exemplar):
+    settings().solid_method = 'COORDINATES'
+    assert run() == {'FINISHED'}
+    volume_obj = bpy.data.objects["crackedground_solid"]
+    values, _, _ = read_solid(volume_obj)
+    assert values.shape[:3] == (16, 16, 16)
+    assert values[..., :3].std(axis=(0, 1, 2)).min() > 0.02  # not a flat solid
+    image = bpy.data.images["cow_solid"]
+    assert image.packed_file is not None
+
+
+def test_coordinates_method_refuses_an_exemplar_too_small_for_its_levels(cow, exemplar):
+    settings().solid_method = 'COORDINATES'
+    settings().solid_levels = 3
+    settings().solid_size = 32
+    exemplar.scale(16, 16)
+    run_expecting_error("too small for method 'coordinates'", objects=[cow])

@@ -23,6 +23,7 @@ namespace {
 
 SolidOptions small_options() {
   SolidOptions o;
+  o.method = SolidMethod::Optimization;  // this file tests the optimiser (test_solid_coordinates.cpp the default)
   o.size = 24;
   o.levels = 2;
   o.iterations = 3;

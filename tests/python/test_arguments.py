@@ -69,7 +69,8 @@ FUNCTIONS = {
         "random_candidates": ("int", 0, 64), "ann_eps": ("real", 0, 1e6), "histogram_matching": "bool",
         "histogram_bins": ("int", 2, 256), "histogram_strength": ("real", 0, 16), "mean_shift": "bool",
         "feature_weight": ("real", 0, 100),
-        "exemplar_values": "bool", "tileable": "bool", "memory_budget": "budget", "seed": "seed", "ctx": "ctx"}),
+        "exemplar_values": "bool", "tileable": "bool", "memory_budget": "budget", "seed": "seed", "ctx": "ctx",
+        "method": "str", "coordinate_coherence_k": ("int", 0, 16)}),
     "synthesize_image": (call("synthesize_image", IMG, width=8, height=8, levels=1, iterations=1), {
         "width": ("int", 1, 16384), "height": ("int", 1, 16384), "levels": ("int", 1, 8), "r": ("real", 0, 2),
         "exemplar_values": "bool", "memory_budget": "budget", "seed": "seed", "tileable": "bool", "ctx": "ctx",
@@ -343,3 +344,11 @@ def test_vdb_arguments_are_checked(tmp_path):
             run()
         for w in words:
             assert w in str(info.value), str(info.value)
+
+
+def test_solid_method_is_checked_in_the_core_and_named():
+    assert _native.SOLID_METHODS == ("optimization", "coordinates")
+    assert _native.SOLID_DEFAULT_METHOD in _native.SOLID_METHODS
+    with pytest.raises(_native.InvalidInputError) as info:
+        _native.synthesize_solid(IMG, size=8, levels=1, method="lazy")
+    assert "'optimization' or 'coordinates'" in str(info.value) and "'lazy'" in str(info.value)

@@ -76,7 +76,9 @@ class EXSYNTH_PT_solid_advanced(SidebarPanel, bpy.types.Panel):
     bl_options = {'DEFAULT_CLOSED'}
 
     def draw(self, context):
-        draw_shared_advanced(self._layout(), context.scene.exsynth)
+        layout = self._layout()
+        layout.prop(context.scene.exsynth, "solid_method")
+        draw_shared_advanced(layout, context.scene.exsynth)
 
 
 CLASSES = (EXSYNTH_PT_solid, EXSYNTH_PT_solid_axes, EXSYNTH_PT_solid_rebake, EXSYNTH_PT_solid_advanced)

@@ -15,6 +15,7 @@
 #include <array>
 #include <cstddef>
 #include <cstdint>
+#include <string>
 #include <vector>
 
 #include "exsynth/exec_context.hpp"
@@ -111,10 +112,48 @@ struct SolidExemplars {
   Volume constraint;
 };
 
+/// How a solid is synthesized.
+enum class SolidMethod {
+  /// Kopf et al. 2007: global texture optimisation of voxel values (above).
+  Optimization,
+  /// Dong et al. 2008 "Lazy Solid Texture Synthesis": every voxel holds
+  /// exemplar coordinates (a triple of texels whose crossbars agree, one per
+  /// view), synthesized coarse to fine by coordinate upsampling and
+  /// correction passes among k-coherence candidates in appearance space
+  /// (PCA of 5x5 neighbourhoods); colours are looked up at the end. Uses
+  /// levels, iterations (correction passes; coarsest 2x, finest as
+  /// finest_iterations), coordinate_coherence_k, pca_variance / max_pca_dims (at most
+  /// kCoordinateFeatureDims), max_exemplar_size, tileable, memory_budget and
+  /// seed; the optimiser's other options do not apply. No constraint volume
+  /// and no feature channel yet. See docs/solid.md.
+  Coordinates,
+};
+/// Appearance-space feature window and largest feature dimension of SolidMethod::Coordinates.
+constexpr int kCoordinateWindow = 5;
+constexpr int kCoordinateFeatureDims = 8;
+
+/// The method names the bindings, add-on and CLI accept, in enum order
+/// ("optimization", "coordinates"), and the default's.
+const std::vector<std::string>& solid_method_names();
+const char* solid_method_name(SolidMethod m);
+/// Parses a name of solid_method_names(); InvalidInput naming them otherwise.
+SolidMethod solid_method_from_name(const std::string& name);
+
 struct SolidOptions : TextureOptimizationOptions {
   int size = 64;  ///< output edge length in voxels (size^3)
+  /// Coordinates meets more of issue 10's slice targets (14 of 32 against
+  /// 9 at 64^3) in about half the CPU at 128^3, but the demo's cow (oblique
+  /// cuts) shows streaks where a view's texel is extruded along its axis, so
+  /// the optimiser stays the default (docs/solid.md, fourth pass).
+  SolidMethod method = SolidMethod::Optimization;
+  /// Coordinates: k-coherence candidates per neighbour's texel (its most
+  /// similar texels). 0 = the neighbours' own texels only: measured as good
+  /// as 1 and 4, and faster (64^3, crackedground / stone33 / brick; docs/solid.md).
+  int coordinate_coherence_k = 0;
   SolidOptions() { finest_iterations = -1; }
 };
+/// The default method's name (SolidOptions{}.method).
+const char* default_solid_method_name();
 
 struct TextureResult {
   Volume texture;                      ///< the solid (size^3 x C), or the image as a (W, H, 1) volume

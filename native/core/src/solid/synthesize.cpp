@@ -12,6 +12,7 @@
 #include "exsynth/rng.hpp"
 #include "exsynth/sample.hpp"
 #include "exsynth/solid.hpp"
+#include "solid/coordinate_synthesis.hpp"
 #include "solid/exemplar_index.hpp"
 #include "solid/feature_channel.hpp"
 #include "solid/level_solver.hpp"
@@ -402,6 +403,7 @@ TextureResult synthesize_solid(const SolidExemplars& ex, const SolidOptions& opt
     ++active;
   }
   if (active < 2) throw InvalidInput("a solid needs at least two active views (x, y, z); got " + std::to_string(active));
+  if (opt.method == SolidMethod::Coordinates) return solid::synthesize_coordinates(job.views, ex.constraint, opt, ctx);
   job.constraint = &ex.constraint;
   return optimize_texture(job, opt, opt.tileable, ctx);
 }
