@@ -19,9 +19,15 @@ SolidSearch to_search(const std::string& s) {
   throw InvalidInput("search must be 'kcoherence', 'kdtree' or 'exact', got '" + s + "'");
 }
 
-// The options both entry points share, in one place.
-// `more_names`, when given, replaces the list of options an unknown one is told.
-void set_common(TextureOptimizationOptions& o, const py::kwargs& kw, const char* more_names = "") {
+// The optimiser's options, which both entry points share.
+constexpr const char* kCommonNames =
+    "levels, neighborhood, iterations, finest_iterations, r, pca_variance, max_pca_dims, search, coherence_k, "
+    "random_candidates, ann_eps, histogram_matching, histogram_bins, histogram_strength, mean_shift, "
+    "coherent_upsampling, exemplar_values, feature_weight, tileable, max_exemplar_size, memory_budget, seed";
+
+// The options both entry points share, in one place; `names`: every option
+// the entry point takes, for the message about an unknown one.
+void set_common(TextureOptimizationOptions& o, const py::kwargs& kw, const std::string& names) {
   for (auto item : kw) {
     const std::string k = py::str(item.first);
     const py::handle v = item.second;
@@ -48,14 +54,8 @@ void set_common(TextureOptimizationOptions& o, const py::kwargs& kw, const char*
     else if (k == "max_exemplar_size") o.max_exemplar_size = int_arg(v, k, 0, 1 << 16);
     else if (k == "memory_budget") o.memory_budget = memory_budget_arg(v, k);
     else if (k == "seed") o.seed = seed_arg(v, k);
-    else if (*more_names)
-      throw InvalidInput("unknown option '" + k + "'; options: " + more_names);
     else
-      throw InvalidInput("unknown option '" + k +
-                         "'; options: levels, neighborhood, iterations, finest_iterations, r, pca_variance, max_pca_dims, search, "
-                         "coherence_k, random_candidates, ann_eps, histogram_matching, histogram_bins, histogram_strength, mean_shift, coherent_upsampling, "
-                         "exemplar_values, "
-                         "feature_weight, tileable, max_exemplar_size, memory_budget, seed");
+      throw InvalidInput("unknown option '" + k + "'; options: " + names);
   }
 }
 
@@ -157,7 +157,7 @@ void bind_solid(py::module_& m) {
           else
             common[item.first] = item.second;
         }
-        set_common(opt, common);
+        set_common(opt, common, std::string("method, coordinate_coherence_k, ") + kCommonNames);
         TextureResult r;
         {
           py::gil_scoped_release release;
