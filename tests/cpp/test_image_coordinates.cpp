@@ -5,7 +5,6 @@
 // bad options.
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
-#include <tbb/global_control.h>
 
 #include <algorithm>
 #include <cmath>
@@ -16,6 +15,7 @@
 #include "image/coordinate_synthesis.hpp"
 #include "support/cancel.hpp"
 #include "support/textures.hpp"
+#include "support/threads.hpp"
 
 using namespace exsynth;
 using exsynth::image::Coord;
@@ -155,15 +155,8 @@ TEST(ImageCoordinates, SameSeedSameImageOnOneAndEightThreads) {
   for (bool tileable : {false, true}) {
     ImageSynthesisOptions o = small_image();
     o.tileable = tileable;
-    Image one, eight;
-    {
-      tbb::global_control limit(tbb::global_control::max_allowed_parallelism, 1);
-      one = synthesize_image(ex, o);
-    }
-    {
-      tbb::global_control limit(tbb::global_control::max_allowed_parallelism, 8);
-      eight = synthesize_image(ex, o);
-    }
+    const Image one = exsynth::testing::on_threads(1, [&] { return synthesize_image(ex, o); });
+    const Image eight = exsynth::testing::on_threads(8, [&] { return synthesize_image(ex, o); });
     EXPECT_EQ(one.values(), eight.values());
     o.seed = 4;
     EXPECT_NE(synthesize_image(ex, o).values(), one.values());

@@ -8,7 +8,6 @@
 // atlas gutters and limit mesh, bad inputs.
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
-#include <tbb/global_control.h>
 
 #include <cmath>
 #include <map>
@@ -17,6 +16,7 @@
 #include "exsynth/errors.hpp"
 #include "exsynth/surface.hpp"
 #include "support/textures.hpp"
+#include "support/threads.hpp"
 #include "surface/charts.hpp"
 #include "surface/methods.hpp"
 #include "surface/texels.hpp"
@@ -607,15 +607,8 @@ TEST(SurfaceSynthesis, CoherentIsDeterministicCoherentAndSeamless) {
   const Image ex = exsynth::testing::disc_texture(40, 40, 3, 5);
   SurfaceSynthesisOptions o = small_options(SurfaceMethod::Coherent);
   o.field = constant_field(m.vertices.size(), V3(1, 0, 0));
-  SurfaceTexture a, b;
-  {
-    tbb::global_control limit(tbb::global_control::max_allowed_parallelism, 1);
-    a = synthesize_surface(s, ex, o);
-  }
-  {
-    tbb::global_control limit(tbb::global_control::max_allowed_parallelism, 8);
-    b = synthesize_surface(s, ex, o);
-  }
+  const SurfaceTexture a = exsynth::testing::on_threads(1, [&] { return synthesize_surface(s, ex, o); });
+  const SurfaceTexture b = exsynth::testing::on_threads(8, [&] { return synthesize_surface(s, ex, o); });
   EXPECT_EQ(a.texels, b.texels);
   EXPECT_EQ(a.source, b.source);
   ASSERT_EQ(a.texel_count(), 16u * 64u);
@@ -644,15 +637,8 @@ TEST(SurfaceSynthesis, MultiscaleIsDeterministicForAnyThreadCount) {
   const Image ex = exsynth::testing::disc_texture(32, 32, 2, 9);
   SurfaceSynthesisOptions o = small_options(SurfaceMethod::Multiscale);
   o.field = constant_field(m.vertices.size(), V3(1, 0, 0));
-  SurfaceTexture one, many;
-  {
-    tbb::global_control limit(tbb::global_control::max_allowed_parallelism, 1);
-    one = synthesize_surface(s, ex, o);
-  }
-  {
-    tbb::global_control limit(tbb::global_control::max_allowed_parallelism, 8);
-    many = synthesize_surface(s, ex, o);
-  }
+  const SurfaceTexture one = exsynth::testing::on_threads(1, [&] { return synthesize_surface(s, ex, o); });
+  const SurfaceTexture many = exsynth::testing::on_threads(8, [&] { return synthesize_surface(s, ex, o); });
   EXPECT_EQ(one.texels, many.texels);
   EXPECT_EQ(one.source, many.source);
   ASSERT_EQ(one.texels.size(), 9u * 64u * 2u);

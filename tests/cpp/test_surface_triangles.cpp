@@ -3,7 +3,6 @@
 // midpoints, the control vertices) are laid out in the charts as regular
 // sectors while the real kites have other angles.
 #include <gtest/gtest.h>
-#include <tbb/global_control.h>
 
 #include <cmath>
 #include <cstdio>
@@ -13,6 +12,7 @@
 #include "surface/charts.hpp"
 #include "surface/methods.hpp"
 #include "surface/texels.hpp"
+#include "support/threads.hpp"
 
 using namespace exsynth;
 using V3 = Eigen::Vector3f;
@@ -104,10 +104,8 @@ TEST(SurfaceTriangles, BothMethodsAreDeterministicForAnyThreadCount) {
       o.seed = 6;
       o.field = std::vector<V3>(m.vertices.size(), V3(1, 0, 0));
       std::vector<SurfaceTexture> runs;
-      for (int threads : {1, 2, 8}) {
-        tbb::global_control limit(tbb::global_control::max_allowed_parallelism, std::size_t(threads));
-        runs.push_back(synthesize_surface(s, ex, o));
-      }
+      for (int threads : {1, 2, 8})
+        runs.push_back(exsynth::testing::on_threads(threads, [&] { return synthesize_surface(s, ex, o); }));
       for (std::size_t i = 1; i < runs.size(); ++i) {
         EXPECT_EQ(runs[0].texels, runs[i].texels);
         EXPECT_EQ(runs[0].source, runs[i].source);
