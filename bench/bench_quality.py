@@ -106,7 +106,7 @@ def main(argv=None):
     image_opts = {k: v for k, v in opts.items() if k not in SOLID_ONLY}
     print(f"machine: {os.cpu_count()} cores; 128^2 exemplars, {args.options or 'default options'}, seed 7; "
           f"solids: mean of x/y/z slices, method {method}")
-    print(f"image method: {opts.get('method', 'coordinates')} (synthesize_image's default: coordinates); "
+    print(f"image method: {opts.get('method', _native.IMAGE_DEFAULT_METHOD)} (synthesize_image's default: {_native.IMAGE_DEFAULT_METHOD}); "
           f"load average at start {os.getloadavg()[0]:.1f}")
     header = f"{'output':<44} " + " ".join(f"{k:>9}" for k in KEYS)
     print(header)

@@ -194,7 +194,7 @@ def _parser():
     p.add_argument("--height", type=_int, required=True, help="output height in pixels")
     p.add_argument("--out", required=True, help="output image (.png)")
     p.add_argument("--tileable", action="store_true", help="make the output tile (opposite edges continue)")
-    p.add_argument("--method", choices=("coordinates", "optimization"), default="coordinates",
+    p.add_argument("--method", choices=_native.IMAGE_METHODS, default=_native.IMAGE_DEFAULT_METHOD,
                    help="coordinates (default: fast, every pixel an exemplar pixel) or optimization")
     p.add_argument("--levels", type=_int, default=3, help="optimization: coarse-to-fine levels (default 3)")
     p.add_argument("--iterations", type=_int, default=3, help="optimization: rounds per level (default 3)")

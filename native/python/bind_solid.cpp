@@ -72,12 +72,6 @@ void check_constraint_weights(const Volume& c) {
                          "it), got " + std::to_string(v[i]) + " at voxel " + std::to_string(i / std::size_t(channels)));
 }
 
-ImageMethod to_method(const std::string& s) {
-  if (s == "coordinates") return ImageMethod::Coordinates;
-  if (s == "optimization") return ImageMethod::Optimization;
-  throw InvalidInput("method must be 'coordinates' or 'optimization', got '" + s + "'");
-}
-
 /// synthesize_image's own options (method and the coordinate method's);
 /// the rest go to set_common.
 py::kwargs set_image_options(ImageSynthesisOptions& o, const py::kwargs& kw) {
@@ -87,7 +81,7 @@ py::kwargs set_image_options(ImageSynthesisOptions& o, const py::kwargs& kw) {
     const std::string k = py::str(item.first);
     const py::handle v = item.second;
     // Ranges as image/coordinate_synthesis.cpp's check (which checks them again).
-    if (k == "method") o.method = to_method(string_arg(v, k, "'coordinates' or 'optimization'"));
+    if (k == "method") o.method = image_method_from_name(string_arg(v, k, "'coordinates' or 'optimization'"));
     else if (k == "jitter") c.jitter = real_arg(v, k, 0.0, 4.0, Ends::Closed, "times the level spacing");
     else if (k == "jitter_from") c.jitter_from = int_arg(v, k, 1, 1024, "pixels (a power of two)");
     else if (k == "corrections") c.corrections = int_arg(v, k, 0, 16);
@@ -127,6 +121,8 @@ void bind_solid(py::module_& m) {
   m.attr("DEFAULT_MAX_EXEMPLAR_SIZE") = kDefaultMaxExemplarSize;
   m.attr("SOLID_METHODS") = py::tuple(py::cast(solid_method_names()));
   m.attr("SOLID_DEFAULT_METHOD") = default_solid_method_name();
+  m.attr("IMAGE_METHODS") = py::tuple(py::cast(image_method_names()));
+  m.attr("IMAGE_DEFAULT_METHOD") = default_image_method_name();
   m.def(
       "synthesize_solid",
       [](const ArrayArg& exemplar, const OptionalArrayArg& exemplar_y, const OptionalArrayArg& exemplar_z,

@@ -349,6 +349,8 @@ def test_vdb_arguments_are_checked(tmp_path):
 def test_solid_method_is_checked_in_the_core_and_named():
     assert _native.SOLID_METHODS == ("optimization", "coordinates")
     assert _native.SOLID_DEFAULT_METHOD in _native.SOLID_METHODS
+    assert _native.IMAGE_METHODS == ("coordinates", "optimization")
+    assert _native.IMAGE_DEFAULT_METHOD == "coordinates"
     with pytest.raises(_native.InvalidInputError) as info:
         _native.synthesize_solid(IMG, size=8, levels=1, method="lazy")
     assert "'optimization' or 'coordinates'" in str(info.value) and "'lazy'" in str(info.value)

@@ -216,6 +216,12 @@ struct ImageSynthesisOptions : TextureOptimizationOptions {
   ImageSynthesisOptions() { tileable = false; }
 };
 
+/// The image method names (in enum order: "coordinates", "optimization"),
+/// the default's, and the parse (InvalidInput naming them otherwise).
+const std::vector<std::string>& image_method_names();
+const char* default_image_method_name();
+ImageMethod image_method_from_name(const std::string& name);
+
 /// 2D synthesis: exemplar -> a width x height image, by `opt.method`.
 Image synthesize_image(const Image& exemplar, const ImageSynthesisOptions& opt = {}, ExecContext* ctx = nullptr,
                        std::vector<double>* energy = nullptr);

@@ -474,3 +474,23 @@ Image synthesize_coordinates(const Image& exemplar, const ImageSynthesisOptions&
 }
 
 }  // namespace exsynth::image
+
+namespace exsynth {
+
+namespace {
+
+const std::vector<std::string> kImageMethodNames{"coordinates", "optimization"};
+
+}  // namespace
+
+const std::vector<std::string>& image_method_names() { return kImageMethodNames; }
+const char* default_image_method_name() {
+  return kImageMethodNames[std::size_t(ImageSynthesisOptions{}.method)].c_str();
+}
+ImageMethod image_method_from_name(const std::string& name) {
+  for (std::size_t i = 0; i < kImageMethodNames.size(); ++i)
+    if (kImageMethodNames[i] == name) return ImageMethod(i);
+  throw InvalidInput("method must be 'coordinates' or 'optimization', got '" + name + "'");
+}
+
+}  // namespace exsynth
