@@ -144,3 +144,12 @@ def test_solid_method_coordinates_and_a_bad_method(tmp_path, capsys):
     assert code == 2
     assert "--method" in err and "'optimization'" in err and "'coordinates'" in err
     assert not (tmp_path / "t.npy").exists()
+
+
+@pytest.mark.parametrize("method", ["coordinates", "optimization"])
+def test_run_image_keeps_to_the_memory_budget_with_either_method(tmp_path, capsys, method):
+    out = tmp_path / "x.png"
+    code, err = run(capsys, "image", "--exemplar", CRACKED, "--method", method, "--width", "4096", "--height", "4096",
+                    "--memory-budget", "0.001", "--out", str(out))
+    assert code == 1 and "over the memory budget" in err and "nothing was written" in err
+    assert os.listdir(tmp_path) == []

@@ -207,17 +207,17 @@ class ImageJob(Job):
     iterations: int = 3
     seed: int = 0
     memory_budget: int = 0
-    method: str = "coordinates"     # or "optimization" (levels, iterations, memory_budget apply to it)
+    method: str = None              # one of _native.IMAGE_METHODS; None = the engine's default
+                                    # (levels and iterations apply to "optimization" only)
 
     label = "image"
 
     def run(self, ctx):
-        extra = {}
-        if self.method == "optimization":
-            extra = dict(levels=self.levels, iterations=self.iterations, memory_budget=self.memory_budget)
+        method = self.method or _native.IMAGE_DEFAULT_METHOD
+        extra = dict(levels=self.levels, iterations=self.iterations) if method == "optimization" else {}
         res = _native.synthesize_image(
             self.exemplar, width=self.width, height=self.height, tileable=self.tileable,
-            seed=self.seed, method=self.method, ctx=ctx, **extra,
+            seed=self.seed, method=method, memory_budget=self.memory_budget, ctx=ctx, **extra,
         )
         return res["image"]  # (height, width, C), row 0 at the top
 
