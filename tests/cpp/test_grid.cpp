@@ -9,20 +9,14 @@
 #include "exsynth/pyramid.hpp"
 #include "exsynth/rng.hpp"
 #include "exsynth/sample.hpp"
+#include "support/textures.hpp"
 
 namespace {
 
 using exsynth::Boundary;
 using exsynth::Image;
 using exsynth::Volume;
-
-Image random_image(int w, int h, int c, std::uint64_t seed) {
-  Image img(w, h, c);
-  for (std::size_t i = 0; i < img.values().size(); ++i) {
-    img.values()[i] = float(exsynth::IndexRng(seed, i).uniform());
-  }
-  return img;
-}
+using exsynth::testing::random_image;
 
 Volume random_volume(int nx, int ny, int nz, int c, std::uint64_t seed) {
   Volume vol(nx, ny, nz, c);

@@ -33,6 +33,14 @@ CoordinateSynthesisOptions plain() {
   return o;
 }
 
+/// One correction pass over `before` at `level` (no progress reporting).
+CoordImage corrected(const CoordinateSolver& s, const CoordImage& before, int level) {
+  CoordImage after = before;
+  StageProgress progress(nullptr, "", 0, 1, 1);
+  s.correct(after, level, progress);
+  return after;
+}
+
 /// The neighbourhood distance written out from its definition: over the
 /// 3 x 3 output neighbours inside the image (or wrapped), the squared
 /// difference between the appearance at the neighbour's coordinate and at
@@ -91,9 +99,7 @@ TEST(ImageCoordinates, ExhaustiveCorrectionFindsTheGlobalMinimum) {
   const CoordinateSolver s(ex, o, false, 5, nullptr, 0, 1);
   const int level = s.levels() - 1;
   const CoordImage before = s.initial(10, 8);
-  CoordImage after = before;
-  StageProgress progress(nullptr, "", 0, 1, 1);
-  s.correct(after, level, progress);
+  const CoordImage after = corrected(s, before, level);
   for (int y = 0; y < before.height; y += 2)
     for (int x = 0; x < before.width; x += 2) {
       double best = std::numeric_limits<double>::infinity();
@@ -112,9 +118,7 @@ TEST(ImageCoordinates, KCoherenceCorrectionTakesTheBestOfItsCandidates) {
     const CoordinateSolver s(ex, o, tileable, 6, nullptr, 0, 1);
     const int level = s.levels() - 1;
     const CoordImage before = s.initial(12, 10);
-    CoordImage after = before;
-    StageProgress progress(nullptr, "", 0, 1, 1);
-    s.correct(after, level, progress);
+    const CoordImage after = corrected(s, before, level);
     int moved = 0;
     for (int y = 0; y < before.height; y += 2)
       for (int x = 0; x < before.width; x += 2) {

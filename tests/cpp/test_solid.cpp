@@ -17,6 +17,7 @@
 
 using namespace exsynth;
 using exsynth::testing::disc_texture;
+using exsynth::testing::one_exemplar;
 using ::testing::HasSubstr;
 
 namespace {
@@ -29,12 +30,6 @@ SolidOptions small_options() {
   o.iterations = 3;
   o.seed = 5;
   return o;
-}
-
-SolidExemplars one_exemplar(const Image& img) {
-  SolidExemplars ex;
-  ex.views[0] = img;
-  return ex;
 }
 
 // Mean over n sampled 8x8 windows of a slice of their distance to the

@@ -18,6 +18,8 @@
 
 using namespace exsynth;
 using exsynth::testing::disc_texture;
+using exsynth::testing::one_exemplar;
+using exsynth::testing::random_image;
 using ::testing::HasSubstr;
 
 namespace {
@@ -30,18 +32,6 @@ SolidOptions coordinate_options() {
   o.iterations = 2;
   o.seed = 3;
   return o;
-}
-
-SolidExemplars one_exemplar(const Image& img) {
-  SolidExemplars ex;
-  ex.views[0] = img;
-  return ex;
-}
-
-Image noise(int w, int h, int c, std::uint64_t seed) {
-  Image img(w, h, c);
-  for (std::size_t i = 0; i < img.values().size(); ++i) img.values()[i] = float(IndexRng(seed, i).uniform());
-  return img;
 }
 
 // Brute-force crossbar cost of a triple, straight from the definition:
@@ -65,7 +55,7 @@ float crossbar_cost(const std::array<const solid::ExemplarIndex*, 3>& views, con
 }  // namespace
 
 TEST(CrossbarCandidates, KdTreeTableEqualsTheBruteForceTable) {
-  const Image x = noise(14, 12, 3, 1), y = noise(12, 13, 3, 2), z = noise(13, 14, 3, 3);
+  const Image x = random_image(14, 12, 3, 1), y = random_image(12, 13, 3, 2), z = random_image(13, 14, 3, 3);
   const std::vector<float> lo(3, 0.0f), hi(3, 1.0f);
   const solid::ExemplarIndex ix(x, 5, 0.95, 8, 2, 16, lo, hi, nullptr, "x", 0, 1);
   const solid::ExemplarIndex iy(y, 5, 0.95, 8, 2, 16, lo, hi, nullptr, "y", 0, 1);
@@ -86,7 +76,7 @@ TEST(CrossbarCandidates, KdTreeTableEqualsTheBruteForceTable) {
 }
 
 TEST(CrossbarCandidates, TwoViewsLeaveTheThirdEmpty) {
-  const Image x = noise(12, 12, 2, 4);
+  const Image x = random_image(12, 12, 2, 4);
   const std::vector<float> lo(2, 0.0f), hi(2, 1.0f);
   const solid::ExemplarIndex ix(x, 5, 0.95, 8, 2, 16, lo, hi, nullptr, "x", 0, 1);
   const std::array<const solid::ExemplarIndex*, 3> views{&ix, nullptr, &ix};

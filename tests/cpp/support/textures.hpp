@@ -1,11 +1,13 @@
 #pragma once
-// Structured synthetic exemplars for C++ tests (PNG exemplars are used in
-// the Python tier): random soft discs on a background, in C channels.
+// Synthetic exemplars for C++ tests (PNG exemplars are used in the Python
+// tier): random soft discs on a background, in C channels; uniform noise;
+// one image as every view of a solid.
 #include <algorithm>
 #include <cmath>
 
 #include "exsynth/grid.hpp"
 #include "exsynth/rng.hpp"
+#include "exsynth/solid.hpp"
 
 namespace exsynth::testing {
 
@@ -25,6 +27,20 @@ inline Image disc_texture(int w, int h, int channels, std::uint64_t seed, int di
       }
   }
   return img;
+}
+
+/// Values uniform in [0, 1), seeded per value index.
+inline Image random_image(int w, int h, int c, std::uint64_t seed) {
+  Image img(w, h, c);
+  for (std::size_t i = 0; i < img.values().size(); ++i) img.values()[i] = float(IndexRng(seed, i).uniform());
+  return img;
+}
+
+/// `img` as the x view; the other views reuse it.
+inline SolidExemplars one_exemplar(const Image& img) {
+  SolidExemplars ex;
+  ex.views[0] = img;
+  return ex;
 }
 
 }  // namespace exsynth::testing
