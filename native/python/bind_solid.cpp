@@ -72,6 +72,19 @@ void check_constraint_weights(const Volume& c) {
                          "it), got " + std::to_string(v[i]) + " at voxel " + std::to_string(i / std::size_t(channels)));
 }
 
+/// synthesize_solid's own options (method, coordinate_coherence_k); the
+/// rest go to set_common.
+py::kwargs set_solid_options(SolidOptions& o, const py::kwargs& kw) {
+  py::kwargs rest;
+  for (auto item : kw) {
+    const std::string k = py::str(item.first);
+    if (k == "method") o.method = solid_method_from_name(string_arg(item.second, k, "'optimization' or 'coordinates'"));
+    else if (k == "coordinate_coherence_k") o.coordinate_coherence_k = int_arg(item.second, k, 0, 16);
+    else rest[item.first] = item.second;
+  }
+  return rest;
+}
+
 /// synthesize_image's own options (method and the coordinate method's);
 /// the rest go to set_common.
 py::kwargs set_image_options(ImageSynthesisOptions& o, const py::kwargs& kw) {
@@ -144,16 +157,7 @@ void bind_solid(py::module_& m) {
         }
         SolidOptions opt;
         opt.size = int_arg(size, "size", 1, 2048, "voxels per edge");
-        py::kwargs common;  // method is the solid's own; the rest is shared with synthesize_image
-        for (auto item : kw) {
-          if (std::string(py::str(item.first)) == "method")
-            opt.method = solid_method_from_name(string_arg(item.second, "method", "'optimization' or 'coordinates'"));
-          else if (std::string(py::str(item.first)) == "coordinate_coherence_k")
-            opt.coordinate_coherence_k = int_arg(item.second, "coordinate_coherence_k", 0, 16);
-          else
-            common[item.first] = item.second;
-        }
-        set_common(opt, common, std::string("method, coordinate_coherence_k, ") + kCommonNames);
+        set_common(opt, set_solid_options(opt, kw), std::string("method, coordinate_coherence_k, ") + kCommonNames);
         TextureResult r;
         {
           py::gil_scoped_release release;
