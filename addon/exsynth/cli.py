@@ -162,11 +162,14 @@ def _parser():
     p.add_argument("--exemplar", required=True, help="exemplar image (any format Blender reads)")
     p.add_argument("--exemplar-y", help="exemplar of the slices across Y (default: --exemplar)")
     p.add_argument("--exemplar-z", help="exemplar of the slices across Z (default: --exemplar)")
-    p.add_argument("--size", type=_int, default=64, help="voxels along each edge of the solid (default 64)")
+    p.add_argument("--size", type=_int, default=_native.SOLID_DEFAULT_SIZE,
+                   help="voxels along each edge of the solid (default %(default)s)")
     p.add_argument("--out", required=True,
                    help=".vdb (grid color, + alpha with --alpha) or .npy ((Z, Y, X, C) float32)")
-    p.add_argument("--levels", type=_int, default=3, help="coarse-to-fine levels (default 3)")
-    p.add_argument("--iterations", type=_int, default=3, help="optimisation rounds per level (default 3)")
+    p.add_argument("--levels", type=_int, default=_native.DEFAULT_LEVELS,
+                   help="coarse-to-fine levels (default %(default)s)")
+    p.add_argument("--iterations", type=_int, default=_native.DEFAULT_ITERATIONS,
+                   help="optimisation rounds per level (default %(default)s)")
     p.add_argument("--method", choices=_native.SOLID_METHODS, default=_native.SOLID_DEFAULT_METHOD,
                    help="optimization (Kopf et al. 2007) or coordinates (exemplar coordinates, Dong et al. 2008: "
                    "crisper slices, streaks on oblique cuts) (default %(default)s)")
@@ -195,9 +198,11 @@ def _parser():
     p.add_argument("--out", required=True, help="output image (.png)")
     p.add_argument("--tileable", action="store_true", help="make the output tile (opposite edges continue)")
     p.add_argument("--method", choices=_native.IMAGE_METHODS, default=_native.IMAGE_DEFAULT_METHOD,
-                   help="coordinates (default: fast, every pixel an exemplar pixel) or optimization")
-    p.add_argument("--levels", type=_int, default=3, help="optimization: coarse-to-fine levels (default 3)")
-    p.add_argument("--iterations", type=_int, default=3, help="optimization: rounds per level (default 3)")
+                   help="coordinates (fast, every pixel an exemplar pixel) or optimization (default %(default)s)")
+    p.add_argument("--levels", type=_int, default=_native.DEFAULT_LEVELS,
+                   help="optimization: coarse-to-fine levels (default %(default)s)")
+    p.add_argument("--iterations", type=_int, default=_native.DEFAULT_ITERATIONS,
+                   help="optimization: rounds per level (default %(default)s)")
     p.add_argument("--seed", type=_seed, default=0, help="random seed (default 0)")
     p.add_argument("--alpha", action="store_true", help="synthesize the exemplar's alpha too")
     p.add_argument("--memory-budget", type=_gib, default=0.0,

@@ -14,7 +14,7 @@ GIB = 1 << 30
 # neighbourhood): a property's min cannot follow Levels, so the hard min is
 # what one level allows and the soft min what the default 3 levels need; the
 # operator checks the pair (operators/solid.py check_size).
-SOLID_DEFAULT_LEVELS = 3
+SOLID_DEFAULT_LEVELS = _native.DEFAULT_LEVELS
 
 # The engine's solid methods (_native.SOLID_METHODS); the enum's identifiers
 # are the names upper-cased, the job passes them back lower-cased.
@@ -105,7 +105,8 @@ class ExSynthSettings(bpy.types.PropertyGroup):
         description="Voxels along each edge of the solid (it is Size × Size × Size and tiles); "
         f"at least {_native.min_texture_size(SOLID_DEFAULT_LEVELS)} with {SOLID_DEFAULT_LEVELS} Levels, "
         f"{_native.min_texture_size(1)} with 1",
-        default=64, min=_native.min_texture_size(1), soft_min=_native.min_texture_size(SOLID_DEFAULT_LEVELS),
+        default=_native.SOLID_DEFAULT_SIZE, min=_native.min_texture_size(1),
+        soft_min=_native.min_texture_size(SOLID_DEFAULT_LEVELS),
         max=256,
     )
     solid_levels: IntProperty(
@@ -117,7 +118,7 @@ class ExSynthSettings(bpy.types.PropertyGroup):
     solid_iterations: IntProperty(
         name="Iterations",
         description="Optimisation rounds per level (more: closer to the exemplar, slower)",
-        default=3, min=1, max=20,
+        default=_native.DEFAULT_ITERATIONS, min=1, max=20,
     )
     solid_method: EnumProperty(
         name="Method",

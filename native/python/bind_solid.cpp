@@ -126,9 +126,14 @@ void bind_solid(py::module_& m) {
         // Ranges as set_common's (solid/synthesize.cpp's check_options).
         return min_texture_size(int_arg(levels, "levels", 1, 8), int_arg(neighborhood, "neighborhood", 3, 32));
       },
-      py::arg("levels") = 3, py::arg("neighborhood") = 8,
+      py::arg("levels") = TextureOptimizationOptions{}.levels,
+      py::arg("neighborhood") = TextureOptimizationOptions{}.neighborhood,
         "Smallest solid size / image width and height accepted with these levels and neighbourhood: the "
         "coarsest level must hold one neighbourhood ((neighborhood - 1) * 2^(levels - 1) + 1; 29 by default).");
+  // The engine's defaults, for the add-on's properties and the CLI's options.
+  m.attr("DEFAULT_LEVELS") = TextureOptimizationOptions{}.levels;
+  m.attr("DEFAULT_ITERATIONS") = TextureOptimizationOptions{}.iterations;
+  m.attr("SOLID_DEFAULT_SIZE") = SolidOptions{}.size;
   m.attr("SOLID_MAX_SIZE") = kMaxSolidSize;
   m.attr("IMAGE_MAX_SIZE") = kMaxImageSize;
   m.attr("DEFAULT_MAX_EXEMPLAR_SIZE") = kDefaultMaxExemplarSize;

@@ -108,6 +108,12 @@ def test_operators_panels_and_settings_are_registered():
         assert getattr(bpy.types, panel).bl_category == "ExSynth"
     s = settings()
     assert (s.solid_size, s.solid_bake_target, s.solid_bake_resolution) == (64, 'IMAGE', 1024)
+    # Levels, iterations and size start at the engine's defaults, as the CLI's do.
+    engine = (_native.SOLID_DEFAULT_SIZE, _native.DEFAULT_LEVELS, _native.DEFAULT_ITERATIONS)
+    assert (s.solid_size, s.solid_levels, s.solid_iterations) == engine
+    from exsynth import cli
+    args = cli._parser().parse_args(["solid", "--exemplar", "ex.png", "--out", "o.npy"])
+    assert (args.size, args.levels, args.iterations) == engine
     rna = s.bl_rna.properties["solid_size"]
     # The engine's size rule: 1 level allows the hard min, the default levels the soft min.
     assert (rna.hard_min, rna.hard_max) == (_native.min_texture_size(1), 256)

@@ -222,6 +222,9 @@ def test_huge_finite_exemplar_values_work(search):
 
 def test_one_size_rule_exposed_and_stated():
     assert _native.min_texture_size(levels=3, neighborhood=8) == 29
+    # The exposed defaults are the ones the engine applies (the add-on and CLI read them).
+    assert _native.min_texture_size() == _native.min_texture_size(levels=_native.DEFAULT_LEVELS)
+    assert (_native.DEFAULT_LEVELS, _native.DEFAULT_ITERATIONS, _native.SOLID_DEFAULT_SIZE) == (3, 3, 64)
     assert _native.min_texture_size(levels=1) == 8
     assert _native.SOLID_MAX_SIZE == 2048 and _native.IMAGE_MAX_SIZE == 16384
     ex = exemplar(size=32)
