@@ -67,24 +67,29 @@ namespace {
 
 // Solid texture synthesis, 64^3 RGB from a 128^2 exemplar, default options
 // (exemplar analysis, levels, the exemplar-values pass).
+// Arg 1 is the method: 0 the optimiser, 1 exemplar coordinates.
 void BM_CancelLatencySolid(benchmark::State& state) {
   exsynth::SolidExemplars ex;
   ex.views[0] = exsynth::testing::disc_texture(128, 128, 3, 7, 60, 6.0f);
   exsynth::SolidOptions opt;
   opt.size = int(state.range(0));
+  opt.method = state.range(1) ? exsynth::SolidMethod::Coordinates : exsynth::SolidMethod::Optimization;
   report(state, "solid", [&](exsynth::ExecContext* ctx) { exsynth::synthesize_solid(ex, opt, ctx); });
 }
-BENCHMARK(BM_CancelLatencySolid)->Arg(64)->ArgName("size")->Unit(benchmark::kSecond)->UseRealTime()->Iterations(1);
+BENCHMARK(BM_CancelLatencySolid)->Args({64, 0})->Args({64, 1})->ArgNames({"size", "coordinates"})
+    ->Unit(benchmark::kSecond)->UseRealTime()->Iterations(1);
 
 // 2D synthesis from a 1024^2 exemplar (a photo's size): the working
 // resolution's pyramid, the exemplar analysis, the levels.
+// Arg 1 is the method: 0 the optimiser, 1 exemplar coordinates (the default).
 void BM_CancelLatencyImage(benchmark::State& state) {
   const exsynth::Image ex = exsynth::testing::disc_texture(int(state.range(0)), int(state.range(0)), 3, 5, 900, 24.0f);
   exsynth::ImageSynthesisOptions opt;
-  opt.method = exsynth::ImageMethod::Optimization;
+  opt.method = state.range(1) ? exsynth::ImageMethod::Coordinates : exsynth::ImageMethod::Optimization;
   opt.width = opt.height = 256;
   report(state, "image", [&](exsynth::ExecContext* ctx) { exsynth::synthesize_image(ex, opt, ctx); });
 }
-BENCHMARK(BM_CancelLatencyImage)->Arg(1024)->ArgName("exemplar")->Unit(benchmark::kSecond)->UseRealTime()->Iterations(1);
+BENCHMARK(BM_CancelLatencyImage)->Args({1024, 0})->Args({1024, 1})->ArgNames({"exemplar", "coordinates"})
+    ->Unit(benchmark::kSecond)->UseRealTime()->Iterations(1);
 
 }  // namespace
