@@ -177,7 +177,7 @@ void bind_solid(py::module_& m) {
         return out;
       },
       py::arg("exemplar"), py::kw_only(), py::arg("exemplar_y") = py::none(), py::arg("exemplar_z") = py::none(),
-      py::arg("views") = "xyz", py::arg("size") = 64, py::arg("constraint") = py::none(),
+      py::arg("views") = "xyz", py::arg("size") = SolidOptions{}.size, py::arg("constraint") = py::none(),
       py::arg("ctx") = py::none(),
       R"doc(Solid texture from 2D exemplars (Kopf et al. 2007).
 

@@ -232,14 +232,10 @@ double LevelSolver::search(int iteration, bool exhaustive, StageProgress& progre
   return energy_count ? energy_sum / double(energy_count) : 0.0;
 }
 
-void LevelSolver::optimize(int iteration, StageProgress& progress) {
-  const bool collect = opt_.mean_shift;
-  const int dims[3] = {tex_.nx(), tex_.ny(), tex_.nz()};
+// Target histogram: the mean of the active views' exemplar histograms,
+// scaled so that a uniform histogram is 1 in every bin.
+std::vector<double> LevelSolver::target_histogram() const {
   const int bins = opt_.histogram_bins;
-  const bool hist = opt_.histogram_matching;
-
-  // Target histogram: the mean of the active views' exemplar histograms,
-  // scaled so that a uniform histogram is 1 in every bin.
   std::vector<double> target(std::size_t(C_) * bins, 0.0);
   int active = 0;
   for (const View& w : views_)
@@ -249,13 +245,122 @@ void LevelSolver::optimize(int iteration, StageProgress& progress) {
         for (int b = 0; b < bins; ++b) target[std::size_t(c) * bins + b] += w.ex->histogram(c, b);
     }
   for (double& t : target) t *= double(bins) / active;
+  return target;
+}
 
+std::vector<std::int64_t> LevelSolver::solid_histogram() const {
+  const int bins = opt_.histogram_bins;
   std::vector<std::int64_t> counts(std::size_t(C_) * bins, 0);
-  if (hist) {
-    const float* d = tex_.data();
-    for (std::size_t v = 0; v < tex_.voxel_count(); ++v)
-      for (int c = 0; c < C_; ++c) ++counts[std::size_t(c) * bins + value_bin(d[v * C_ + c], channel_lo_[c], channel_hi_[c], bins)];
+  const float* d = tex_.data();
+  for (std::size_t v = 0; v < tex_.voxel_count(); ++v)
+    for (int c = 0; c < C_; ++c) ++counts[std::size_t(c) * bins + value_bin(d[v * C_ + c], channel_lo_[c], channel_hi_[c], bins)];
+  return counts;
+}
+
+// Per exemplar pixel: (1 + sum_c max(0, H_solid - H_exemplar))^-p at its bins
+// (all 1 without histogram matching). The excess sums over channels, so many
+// channels would multiply the re-weighting: the exponent is as measured on RGB
+// for up to 3 channels and scaled by 3 / C above (6 channels: half).
+void LevelSolver::histogram_factors(const std::vector<std::int64_t>& counts, const std::vector<double>& target,
+                                    std::array<std::vector<float>, 3>& factor) const {
+  const int bins = opt_.histogram_bins;
+  const double strength = C_ <= 3 || opt_.histogram_strength == 1.0 ? opt_.histogram_strength : opt_.histogram_strength * 3.0 / C_;
+  const double total = double(tex_.voxel_count());
+  for (int i = 0; i < 3; ++i) {
+    const View& w = views_[i];
+    if (!w.ex) continue;
+    const Image& img = w.ex->image();
+    factor[i].assign(img.pixel_count(), 1.0f);
+    if (!opt_.histogram_matching) continue;
+    for (std::size_t p = 0; p < img.pixel_count(); ++p) {
+      double excess = 0.0;
+      for (int c = 0; c < C_; ++c) {
+        const std::size_t k = std::size_t(c) * bins + w.ex->bin(p, c);
+        excess += std::max(0.0, counts[k] * bins / total - target[k]);
+      }
+      factor[i][p] = float(strength == 1.0 ? 1.0 / (1.0 + excess) : std::pow(1.0 + excess, -strength));
+    }
   }
+}
+
+namespace {
+
+// Mean shift from the weighted mean `acc` with a shrinking Gaussian bandwidth:
+// converges to the dominant cluster of the C-channel `values` instead of
+// blurring modes. `mode` is scratch of C floats.
+void mean_shift(const std::vector<float>& values, const std::vector<float>& weights, float wsum, int C,
+                std::vector<float>& acc, std::vector<float>& mode) {
+  float var = 0.0f;
+  for (std::size_t q = 0; q < weights.size(); ++q)
+    for (int c = 0; c < C; ++c) var += weights[q] * (values[q * C + c] - acc[c]) * (values[q * C + c] - acc[c]);
+  float h2 = std::max(var / wsum, 1e-8f);
+  for (int step = 0; step < 4; ++step, h2 *= 0.25f) {
+    std::fill(mode.begin(), mode.end(), 0.0f);
+    float ksum = 0.0f;
+    for (std::size_t q = 0; q < weights.size(); ++q) {
+      float d2 = 0.0f;
+      for (int c = 0; c < C; ++c) d2 += (values[q * C + c] - acc[c]) * (values[q * C + c] - acc[c]);
+      const float kq = weights[q] * std::exp(-0.5f * d2 / h2);
+      for (int c = 0; c < C; ++c) mode[c] += kq * values[q * C + c];
+      ksum += kq;
+    }
+    if (ksum < 1e-12f) break;
+    for (int c = 0; c < C; ++c) acc[c] = mode[c] / ksum;
+  }
+}
+
+}  // namespace
+
+// The weighted mean of the exemplar texels the matched windows of every
+// active view put on voxel p (IRLS weight x histogram factor), into
+// scratch.acc; false when no window covers p. With mean shift, the texels and
+// weights are kept in scratch for it.
+bool LevelSolver::blend_voxel(const int p[3], const OptimizeTables& tables, VoxelScratch& scratch) const {
+  std::fill(scratch.acc.begin(), scratch.acc.end(), 0.0f);
+  float wsum = 0.0f;
+  scratch.values.clear();
+  scratch.weights.clear();
+  for (int i = 0; i < 3; ++i) {
+    const View& w = views_[i];
+    if (!w.ex) continue;
+    const SliceAxes& s = kSlices[i];
+    const Image& img = w.ex->image();
+    const Covering cov = cover(p, s);
+    const std::size_t slice = std::size_t(p[s.axis]) * w.nv;
+    const std::int32_t* corner = tables.window_corner[i].data();
+    const float* fac = tables.factor[i].data();
+    for (int a = 0; a < cov.nv; ++a) {
+      const std::size_t row = (slice + cov.sv[a]) * w.nu;
+      const std::size_t pix_dv = std::size_t(cov.dv[a]) * img.width();
+      for (int b = 0; b < cov.nu; ++b) {
+        const std::size_t sp = row + cov.su[b];
+        const int j = w.match[sp];
+        if (j < 0) continue;
+        const std::size_t pix = std::size_t(corner[j]) + pix_dv + cov.du[b];
+        const float wt = w.weight[sp] * fac[pix];
+        const float* e = img.data() + pix * C_;
+        for (int c = 0; c < C_; ++c) scratch.acc[c] += wt * e[c];
+        wsum += wt;
+        if (opt_.mean_shift) {
+          scratch.values.insert(scratch.values.end(), e, e + C_);
+          scratch.weights.push_back(wt);
+        }
+      }
+    }
+  }
+  if (wsum <= 0.0f) return false;
+  for (int c = 0; c < C_; ++c) scratch.acc[c] /= wsum;
+  if (opt_.mean_shift && scratch.weights.size() > 1)
+    mean_shift(scratch.values, scratch.weights, wsum, C_, scratch.acc, scratch.mode);
+  return true;
+}
+
+void LevelSolver::optimize(int iteration, StageProgress& progress) {
+  const int dims[3] = {tex_.nx(), tex_.ny(), tex_.nz()};
+  const int bins = opt_.histogram_bins;
+  const bool hist = opt_.histogram_matching;
+  const std::vector<double> target = hist ? target_histogram() : std::vector<double>();
+  std::vector<std::int64_t> counts = hist ? solid_histogram() : std::vector<std::int64_t>();
 
   // Blocks of voxels in a seeded random order, processed in groups: within a
   // group in parallel against the histogram as it was at the group's start,
@@ -270,50 +375,25 @@ void LevelSolver::optimize(int iteration, StageProgress& progress) {
   for (std::size_t k = blocks; k > 1; --k) std::swap(order[k - 1], order[shuffle.below(k)]);
   const std::size_t groups = std::min<std::size_t>(blocks, 16);
 
-  // Per exemplar pixel: (1 + sum_c max(0, H_solid - H_exemplar))^-p at its bins.
-  // The excess sums over channels, so many channels would multiply the
-  // re-weighting: the exponent is as measured on RGB for up to 3 channels and
-  // scaled by 3 / C above (6 channels: half).
-  const double strength = C_ <= 3 || opt_.histogram_strength == 1.0 ? opt_.histogram_strength : opt_.histogram_strength * 3.0 / C_;
-  std::array<std::vector<float>, 3> factor;
-  auto update_factors = [&] {
-    const double total = double(tex_.voxel_count());
-    for (int i = 0; i < 3; ++i) {
-      const View& w = views_[i];
-      if (!w.ex) continue;
-      const Image& img = w.ex->image();
-      factor[i].assign(img.pixel_count(), 1.0f);
-      if (!hist) continue;
-      for (std::size_t p = 0; p < img.pixel_count(); ++p) {
-        double excess = 0.0;
-        for (int c = 0; c < C_; ++c) {
-          const std::size_t k = std::size_t(c) * bins + w.ex->bin(p, c);
-          excess += std::max(0.0, counts[k] * bins / total - target[k]);
-        }
-        factor[i][p] = float(strength == 1.0 ? 1.0 / (1.0 + excess) : std::pow(1.0 + excess, -strength));
-      }
-    }
-  };
-
   // window_corner[i][j] = pixel index of window j's top-left texel in view
   // i's exemplar.
-  std::array<std::vector<std::int32_t>, 3> window_corner;
+  OptimizeTables tables;
   for (int i = 0; i < 3; ++i) {
     const View& w = views_[i];
     if (!w.ex) continue;
-    window_corner[i].resize(w.ex->count());
+    tables.window_corner[i].resize(w.ex->count());
     for (int j = 0; j < w.ex->count(); ++j)
-      window_corner[i][j] = (w.ex->centre_v(j) - lo_) * w.ex->image().width() + (w.ex->centre_u(j) - lo_);
+      tables.window_corner[i][j] = (w.ex->centre_v(j) - lo_) * w.ex->image().width() + (w.ex->centre_u(j) - lo_);
   }
 
   std::vector<std::vector<std::int64_t>> deltas;
   for (std::size_t g = 0; g < groups; ++g) {
-    update_factors();
+    histogram_factors(counts, target, tables.factor);
     const std::size_t g0 = g * blocks / groups, g1 = (g + 1) * blocks / groups;
     deltas.assign(g1 - g0, {});
     parallel_chunks(g1 - g0, 1, progress, [&](std::size_t k0, std::size_t k1) {
-      std::vector<float> values, weights;
-      std::vector<float> acc(C_), mode(C_);
+      VoxelScratch scratch{std::vector<float>(C_), std::vector<float>(C_), {}, {}};
+      std::vector<float>& acc = scratch.acc;
       for (std::size_t k = k0; k < k1; ++k) {
         std::vector<std::int64_t>& delta = deltas[k];
         if (hist) delta.assign(std::size_t(C_) * bins, 0);
@@ -323,61 +403,7 @@ void LevelSolver::optimize(int iteration, StageProgress& progress) {
           for (int y = y0; y < std::min(y0 + B, dims[1]); ++y)
             for (int x = x0; x < std::min(x0 + B, dims[0]); ++x) {
               const int p[3] = {x, y, z};
-              std::fill(acc.begin(), acc.end(), 0.0f);
-              float wsum = 0.0f;
-              values.clear();
-              weights.clear();
-              for (int i = 0; i < 3; ++i) {
-                const View& w = views_[i];
-                if (!w.ex) continue;
-                const SliceAxes& s = kSlices[i];
-                const Image& img = w.ex->image();
-                const Covering cov = cover(p, s);
-                const std::size_t slice = std::size_t(p[s.axis]) * w.nv;
-                const std::int32_t* corner = window_corner[i].data();
-                const float* fac = factor[i].data();
-                for (int a = 0; a < cov.nv; ++a) {
-                  const std::size_t row = (slice + cov.sv[a]) * w.nu;
-                  const std::size_t pix_dv = std::size_t(cov.dv[a]) * img.width();
-                  for (int b = 0; b < cov.nu; ++b) {
-                    const std::size_t sp = row + cov.su[b];
-                    const int j = w.match[sp];
-                    if (j < 0) continue;
-                    const std::size_t pix = std::size_t(corner[j]) + pix_dv + cov.du[b];
-                    const float wt = w.weight[sp] * fac[pix];
-                    const float* e = img.data() + pix * C_;
-                    for (int c = 0; c < C_; ++c) acc[c] += wt * e[c];
-                    wsum += wt;
-                    if (collect) {
-                      values.insert(values.end(), e, e + C_);
-                      weights.push_back(wt);
-                    }
-                  }
-                }
-              }
-              if (wsum <= 0.0f) continue;
-              for (int c = 0; c < C_; ++c) acc[c] /= wsum;
-              if (opt_.mean_shift && weights.size() > 1) {
-                // Mean shift from the mean with a shrinking Gaussian bandwidth:
-                // converges to the dominant cluster instead of blurring modes.
-                float var = 0.0f;
-                for (std::size_t q = 0; q < weights.size(); ++q)
-                  for (int c = 0; c < C_; ++c) var += weights[q] * (values[q * C_ + c] - acc[c]) * (values[q * C_ + c] - acc[c]);
-                float h2 = std::max(var / wsum, 1e-8f);
-                for (int step = 0; step < 4; ++step, h2 *= 0.25f) {
-                  std::fill(mode.begin(), mode.end(), 0.0f);
-                  float ksum = 0.0f;
-                  for (std::size_t q = 0; q < weights.size(); ++q) {
-                    float d2 = 0.0f;
-                    for (int c = 0; c < C_; ++c) d2 += (values[q * C_ + c] - acc[c]) * (values[q * C_ + c] - acc[c]);
-                    const float kq = weights[q] * std::exp(-0.5f * d2 / h2);
-                    for (int c = 0; c < C_; ++c) mode[c] += kq * values[q * C_ + c];
-                    ksum += kq;
-                  }
-                  if (ksum < 1e-12f) break;
-                  for (int c = 0; c < C_; ++c) acc[c] = mode[c] / ksum;
-                }
-              }
+              if (!blend_voxel(p, tables, scratch)) continue;
               if (!constraint_.empty()) {
                 const float wc = std::clamp(constraint_.at(x, y, z, C_), 0.0f, 1.0f);
                 for (int c = 0; c < C_; ++c) acc[c] = (1.0f - wc) * acc[c] + wc * constraint_.at(x, y, z, c);

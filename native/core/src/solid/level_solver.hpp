@@ -63,6 +63,21 @@ class LevelSolver {
 
   void gather(int i, std::size_t sparse, float* row) const;
 
+  // The optimisation phase's pieces (level_solver.cpp).
+  struct OptimizeTables {
+    std::array<std::vector<std::int32_t>, 3> window_corner;  // per view: window j's top-left pixel index
+    std::array<std::vector<float>, 3> factor;                // per view: histogram factor per exemplar pixel
+  };
+  struct VoxelScratch {
+    std::vector<float> acc, mode;      // C floats each: the voxel's value, mean-shift scratch
+    std::vector<float> values, weights;  // the covering texels and weights (mean shift only)
+  };
+  std::vector<double> target_histogram() const;
+  std::vector<std::int64_t> solid_histogram() const;
+  void histogram_factors(const std::vector<std::int64_t>& counts, const std::vector<double>& target,
+                         std::array<std::vector<float>, 3>& factor) const;
+  bool blend_voxel(const int p[3], const OptimizeTables& tables, VoxelScratch& scratch) const;
+
   // The sparse voxels whose windows cover voxel p in a slice of axes s: per
   // slice axis, the offsets d (0..n-1) with p - (d - lo) on the sparse grid
   // (even, inside the texture or wrapped) and that sparse coordinate. They
