@@ -66,7 +66,6 @@ struct Dims {
   std::size_t voxels() const { return std::size_t(d[0]) * d[1] * d[2]; }
 };
 
-/// Level sizes, coarsest first; each level halves (rounding up) like the pyramids.
 // The finest level's rounds (finest_iterations: > 0 as given, 0 = iterations,
 // -1 = by the level's size).
 int finest_rounds(const TextureOptimizationOptions& opt, const Dims& finest) {
@@ -76,6 +75,7 @@ int finest_rounds(const TextureOptimizationOptions& opt, const Dims& finest) {
   return opt.iterations;
 }
 
+/// Level sizes, coarsest first; each level halves (rounding up) like the pyramids.
 std::vector<Dims> level_dims(Dims finest, int levels) {
   std::vector<Dims> out(levels);
   out[levels - 1] = finest;
@@ -119,42 +119,54 @@ struct Job {
   std::string name;                      // "solid" or "image", for stages and messages
 };
 
-TextureResult optimize_texture(const Job& job, const TextureOptimizationOptions& opt, bool wrap, ExecContext* ctx) {
-  check_options(opt);
-  const int L = opt.levels, n = opt.neighborhood;
-
-  // Distinct exemplars (views may share one) and their pyramids.
+// The job's exemplars as the optimiser reads them: each distinct exemplar
+// once (views may share one), at its working resolution, value-scaled, with
+// the feature channel appended. `images` points into the owned vectors, which
+// are reserved up front and never reallocate; so the struct stays put.
+struct PreparedExemplars {
   std::vector<const Image*> images;
-  std::array<int, 3> image_of{-1, -1, -1};
+  std::array<int, 3> image_of{-1, -1, -1};  // per view: index into images, -1 = inactive
+  int user_channels = 0, channels = 0;      // channels counts the feature channel
+  int exponent = 0;                         // values were scaled by 2^-exponent
+  const Volume* constraint = nullptr;       // the job's, scaled like the exemplars
+  std::vector<Image> working, scaled, featured;
+  Volume scaled_constraint;
+
+  PreparedExemplars() = default;
+  PreparedExemplars(const PreparedExemplars&) = delete;
+  PreparedExemplars& operator=(const PreparedExemplars&) = delete;
+};
+
+void distinct_exemplars(const Job& job, PreparedExemplars& p) {
   int channels = -1;
   for (int i = 0; i < 3; ++i) {
     if (!job.views[i]) continue;
-    auto it = std::find(images.begin(), images.end(), job.views[i]);
-    if (it == images.end()) {
+    auto it = std::find(p.images.begin(), p.images.end(), job.views[i]);
+    if (it == p.images.end()) {
       const std::string what = job.name == "image" ? "the exemplar" : std::string("the exemplar for view ") + kViewName[i];
       check_exemplar(*job.views[i], what);
       if (channels >= 0 && job.views[i]->channels() != channels)
         throw InvalidInput("the exemplars have different channel counts (" + std::to_string(channels) + " and " +
                            std::to_string(job.views[i]->channels()) + "); give every view the same channels");
       channels = job.views[i]->channels();
-      images.push_back(job.views[i]);
-      it = images.end() - 1;
+      p.images.push_back(job.views[i]);
+      it = p.images.end() - 1;
     }
-    image_of[i] = int(it - images.begin());
+    p.image_of[i] = int(it - p.images.begin());
   }
-  if (images.empty()) throw InvalidInput("no exemplar: give at least one exemplar image and one active view");
-  const int user_channels = channels;
-  StageProgress prepare(ctx, job.name + ": preparing the exemplars", 0.0, 0.0, 1);
+  if (p.images.empty()) throw InvalidInput("no exemplar: give at least one exemplar image and one active view");
+  p.user_channels = p.channels = channels;
+}
 
+void prepare_exemplars(const Job& job, const TextureOptimizationOptions& opt, PreparedExemplars& p) {
   // Working resolution: large exemplars are analysed at a reduced size.
-  std::vector<Image> working;
-  working.reserve(images.size());
-  for (const Image*& img : images)
+  p.working.reserve(p.images.size());
+  for (const Image*& img : p.images)
     if (opt.max_exemplar_size > 0 && std::max(img->width(), img->height()) > opt.max_exemplar_size) {
       Image w = downsample(*img, Boundary::Clamp);
       while (std::max(w.width(), w.height()) > opt.max_exemplar_size) w = downsample(w, Boundary::Clamp);
-      working.push_back(std::move(w));
-      img = &working.back();
+      p.working.push_back(std::move(w));
+      img = &p.working.back();
     }
 
   // Value scale: distances are squared in float, so values near 1e18 and
@@ -162,110 +174,195 @@ TextureResult optimize_texture(const Job& job, const TextureOptimizationOptions&
   // targets) outside [1/16, 16] in magnitude are scaled by a power of two,
   // which is exact and leaves the optimisation unchanged, and the result is
   // scaled back: any finite input works.
-  const int exponent = value_exponent(images, job.constraint, channels);
-  const float scale = std::ldexp(1.0f, -exponent);
-  std::vector<Image> scaled;
-  Volume scaled_constraint;
-  if (exponent != 0) {
-    scaled.reserve(images.size());
-    for (const Image*& img : images) {
-      scaled.push_back(*img);
-      for (float& v : scaled.back().values()) v *= scale;
-      img = &scaled.back();
+  p.exponent = value_exponent(p.images, job.constraint, p.channels);
+  const float scale = std::ldexp(1.0f, -p.exponent);
+  const bool constrained = job.constraint && !job.constraint->empty();
+  p.constraint = job.constraint;
+  if (p.exponent != 0) {
+    p.scaled.reserve(p.images.size());
+    for (const Image*& img : p.images) {
+      p.scaled.push_back(*img);
+      for (float& v : p.scaled.back().values()) v *= scale;
+      img = &p.scaled.back();
     }
-    if (job.constraint && !job.constraint->empty()) {
-      scaled_constraint = *job.constraint;
-      const std::size_t cc = std::size_t(scaled_constraint.channels());
-      for (std::size_t i = 0; i < scaled_constraint.values().size(); ++i)
-        if (i % cc != cc - 1) scaled_constraint.values()[i] *= scale;  // the last channel is a weight
+    if (constrained) {
+      p.scaled_constraint = *job.constraint;
+      const std::size_t cc = std::size_t(p.scaled_constraint.channels());
+      for (std::size_t i = 0; i < p.scaled_constraint.values().size(); ++i)
+        if (i % cc != cc - 1) p.scaled_constraint.values()[i] *= scale;  // the last channel is a weight
+      p.constraint = &p.scaled_constraint;
     }
   }
-  const Volume* constraint_in = exponent != 0 && job.constraint && !job.constraint->empty() ? &scaled_constraint : job.constraint;
-  std::vector<Image> featured;  // exemplars with the feature-distance channel appended
-  if (opt.feature_weight > 0) {
-    if (constraint_in && !constraint_in->empty())
+  if (opt.feature_weight > 0) {  // the feature-distance channel appended
+    if (constrained)
       throw InvalidInput("the feature-distance channel cannot be combined with a constraint volume yet; "
                          "set feature_weight=0 or drop the constraint");
-    featured.reserve(images.size());
-    for (const Image* img : images) featured.push_back(solid::with_feature_channel(*img, float(opt.feature_weight), n));
-    for (std::size_t e = 0; e < images.size(); ++e) images[e] = &featured[e];
-    ++channels;
+    p.featured.reserve(p.images.size());
+    for (const Image* img : p.images)
+      p.featured.push_back(solid::with_feature_channel(*img, float(opt.feature_weight), opt.neighborhood));
+    for (std::size_t e = 0; e < p.images.size(); ++e) p.images[e] = &p.featured[e];
+    ++p.channels;
   }
+}
 
-  const std::vector<Dims> dims = level_dims(job.finest, L);
+void check_constraint(const Job& job, int channels) {
+  if (!job.constraint || job.constraint->empty()) return;
+  const Volume& c = *job.constraint;
+  if (c.nx() != job.finest.d[0] || c.ny() != job.finest.d[1] || c.nz() != job.finest.d[2] || c.channels() != channels + 1)
+    throw InvalidInput("the constraint volume must be " + std::to_string(job.finest.d[0]) + "x" + std::to_string(job.finest.d[1]) +
+                       "x" + std::to_string(job.finest.d[2]) + " voxels with " + std::to_string(channels + 1) +
+                       " channels (the exemplar's " + std::to_string(channels) + " target values, then a weight), got " +
+                       std::to_string(c.nx()) + "x" + std::to_string(c.ny()) + "x" + std::to_string(c.nz()) + " with " +
+                       std::to_string(c.channels()));
+  for (float v : c.values())
+    if (!std::isfinite(v)) throw InvalidInput("the constraint volume has a non-finite value; fix it first");
+}
 
-  PyramidOptions popt;
-  popt.levels = L;
-  std::vector<std::vector<Image>> pyramids;
-  for (std::size_t e = 0; e < images.size(); ++e) {
-    pyramids.push_back(gaussian_pyramid(*images[e], popt));
-    const Image& coarsest = pyramids.back().back();
-    if (coarsest.width() < n || coarsest.height() < n)
-      throw InvalidInput("an exemplar of " + std::to_string(images[e]->width()) + "x" + std::to_string(images[e]->height()) +
-                         " pixels is " + std::to_string(coarsest.width()) + "x" + std::to_string(coarsest.height()) +
-                         " at the coarsest of " + std::to_string(L) + " levels, smaller than the " + std::to_string(n) + "x" +
-                         std::to_string(n) + " neighbourhood; use a larger exemplar, fewer levels or a smaller neighbourhood");
+// Peak memory: the finest texture twice (upsampling), the sparse matches,
+// weights and energies (double-buffered), the exemplar-values sources, the
+// constraint pyramid and the exemplar analysis (neighbourhoods, coefficients,
+// k-NN lists per thread). Each part's advice names its own cause.
+void check_texture_memory(const Job& job, const TextureOptimizationOptions& opt, const PreparedExemplars& p) {
+  const int n = opt.neighborhood, channels = p.channels;
+  const double voxels = double(job.finest.voxels());
+  double texture_bytes = voxels * channels * 4.0 * 2.0 + voxels * 3.0 / 4.0 * 16.0;
+  if (opt.exemplar_values) texture_bytes += voxels * 4.0;  // TextureResult::source
+  if (p.constraint && !p.constraint->empty()) texture_bytes += voxels * (channels + 1) * 4.0 * 8.0 / 7.0;
+  double exemplar_bytes = 0;
+  const Image* largest = p.images[0];
+  for (const Image* img : p.images) {
+    const double count = double(img->width() - n + 1) * (img->height() - n + 1);
+    exemplar_bytes += count * (double(n) * n * channels + opt.max_pca_dims + 8 + opt.coherence_k) * 4.0 * 1.5;
+    if (img->pixel_count() > largest->pixel_count()) largest = img;
   }
+  const std::string size = job.name == "image" ? std::to_string(job.finest.d[0]) + "x" + std::to_string(job.finest.d[1])
+                                               : std::to_string(job.finest.d[0]) + "^3";
+  const std::string exemplar = std::to_string(largest->width()) + "x" + std::to_string(largest->height()) + " " +
+                               std::to_string(channels) + "-channel exemplar";
+  if (exemplar_bytes >= texture_bytes)
+    check_memory_budget(texture_bytes + exemplar_bytes, opt.memory_budget,
+                        "analysing the " + exemplar + " (" + std::to_string(n) + "x" + std::to_string(n) +
+                            " neighbourhoods) for a " + size + " " + job.name,
+                        "the exemplar is too big: give a smaller exemplar or a lower max_exemplar_size (working "
+                        "resolution), fewer channels or a smaller neighbourhood, or raise the memory budget");
+  else
+    check_memory_budget(texture_bytes + exemplar_bytes, opt.memory_budget, "synthesizing a " + size + " " + job.name,
+                        "lower the size or raise the memory budget");
+}
 
-  if (job.constraint && !job.constraint->empty()) {
-    const Volume& c = *job.constraint;
-    if (c.nx() != job.finest.d[0] || c.ny() != job.finest.d[1] || c.nz() != job.finest.d[2] || c.channels() != channels + 1)
-      throw InvalidInput("the constraint volume must be " + std::to_string(job.finest.d[0]) + "x" + std::to_string(job.finest.d[1]) +
-                         "x" + std::to_string(job.finest.d[2]) + " voxels with " + std::to_string(channels + 1) +
-                         " channels (the exemplar's " + std::to_string(channels) + " target values, then a weight), got " +
-                         std::to_string(c.nx()) + "x" + std::to_string(c.ny()) + "x" + std::to_string(c.nz()) + " with " +
-                         std::to_string(c.channels()));
-    for (float v : c.values())
-      if (!std::isfinite(v)) throw InvalidInput("the constraint volume has a non-finite value; fix it first");
-  }
-
-  // Peak memory: the finest texture twice (upsampling), the sparse matches,
-  // weights and energies (double-buffered), the exemplar-values sources, the
-  // constraint pyramid and the exemplar analysis (neighbourhoods,
-  // coefficients, k-NN lists per thread).
-  // Each part's advice names its own cause.
-  {
-    const double voxels = double(job.finest.voxels());
-    double texture_bytes = voxels * channels * 4.0 * 2.0 + voxels * 3.0 / 4.0 * 16.0;
-    if (opt.exemplar_values) texture_bytes += voxels * 4.0;  // TextureResult::source
-    if (constraint_in && !constraint_in->empty()) texture_bytes += voxels * (channels + 1) * 4.0 * 8.0 / 7.0;
-    double exemplar_bytes = 0;
-    const Image* largest = images[0];
-    for (const Image* img : images) {
-      const double count = double(img->width() - n + 1) * (img->height() - n + 1);
-      exemplar_bytes += count * (double(n) * n * channels + opt.max_pca_dims + 8 + opt.coherence_k) * 4.0 * 1.5;
-      if (img->pixel_count() > largest->pixel_count()) largest = img;
-    }
-    const std::string size = job.name == "image" ? std::to_string(job.finest.d[0]) + "x" + std::to_string(job.finest.d[1])
-                                                 : std::to_string(job.finest.d[0]) + "^3";
-    const std::string exemplar = std::to_string(largest->width()) + "x" + std::to_string(largest->height()) + " " +
-                                 std::to_string(channels) + "-channel exemplar";
-    if (exemplar_bytes >= texture_bytes)
-      check_memory_budget(texture_bytes + exemplar_bytes, opt.memory_budget,
-                          "analysing the " + exemplar + " (" + std::to_string(n) + "x" + std::to_string(n) +
-                              " neighbourhoods) for a " + size + " " + job.name,
-                          "the exemplar is too big: give a smaller exemplar or a lower max_exemplar_size (working "
-                          "resolution), fewer channels or a smaller neighbourhood, or raise the memory budget");
-    else
-      check_memory_budget(texture_bytes + exemplar_bytes, opt.memory_budget, "synthesizing a " + size + " " + job.name,
-                          "lower the size or raise the memory budget");
-  }
-
-  // Value ranges for the histogram bins: the exemplars' (finest level).
-  std::vector<float> lo(channels, std::numeric_limits<float>::max()), hi(channels, std::numeric_limits<float>::lowest());
+// Value ranges for the histogram bins: the exemplars' (finest level).
+void value_ranges(const std::vector<const Image*>& images, int channels, std::vector<float>& lo, std::vector<float>& hi) {
+  lo.assign(channels, std::numeric_limits<float>::max());
+  hi.assign(channels, std::numeric_limits<float>::lowest());
   for (const Image* img : images)
     for (std::size_t p = 0; p < img->pixel_count(); ++p)
       for (int c = 0; c < channels; ++c) {
         lo[c] = std::min(lo[c], img->data()[p * channels + c]);
         hi[c] = std::max(hi[c], img->data()[p * channels + c]);
       }
+}
+
+// The coarsest level's start: random exemplar texels of the first active
+// view (Kopf et al. initialise from the exemplar).
+Volume random_texels(const Dims& d, const std::array<const solid::ExemplarIndex*, 3>& views, int channels,
+                     std::uint64_t seed) {
+  int first_view = 0;
+  while (!views[first_view]) ++first_view;  // validated: one view is active
+  const Image& ex = views[first_view]->image();
+  Volume tex(d.d[0], d.d[1], d.d[2], channels);
+  for (std::size_t v = 0; v < tex.voxel_count(); ++v) {
+    IndexRng rng(seed, v, 0x1417);
+    const std::size_t pix = rng.below(ex.pixel_count());
+    std::copy(ex.data() + pix * channels, ex.data() + (pix + 1) * channels, tex.data() + v * channels);
+  }
+  return tex;
+}
+
+// One level's rounds of search and optimisation (and the exemplar-values
+// pass at the finest level), energies appended to `result`.
+void optimize_level(solid::LevelSolver& solver, const Job& job, const TextureOptimizationOptions& opt, const Dims& d,
+                    int l, double energy_scale, double p0, double p1, ExecContext* ctx, TextureResult& result) {
+  const int L = opt.levels;
+  const std::string stage = job.name + ": level " + std::to_string(l + 1) + "/" + std::to_string(L);
+  const bool coarsest = l == 0, finest = l == L - 1;
+  // finest_iterations applies from two levels on (a single level is also
+  // the coarsest, which needs its 2x to converge).
+  const int iterations = coarsest ? 2 * opt.iterations : finest ? finest_rounds(opt, d) : opt.iterations;
+  const bool exemplar_values = finest && opt.exemplar_values;
+  // With exemplar values the finest level's last optimisation would be
+  // overwritten voxel for voxel: the pass reads only the matches and
+  // weights of the last search, and a voxel it leaves (no covering window)
+  // is one the optimisation leaves too. So it is skipped (same output;
+  // measured 2.1 s of 28.6 s CPU at 128^3).
+  const int optimisations = exemplar_values ? iterations - 1 : iterations;
+  StageProgress progress(ctx, stage, p0 + 0.1 * (p1 - p0), p1,
+                         std::size_t(iterations) * solver.search_units() +
+                             std::size_t(optimisations) * solver.optimize_units() +
+                             (!coarsest && opt.coherent_upsampling ? solver.optimize_units() : 0) +
+                             (exemplar_values ? solver.discrete_units() : 0));
+  // Coherent upsampling: the finer level's texture is first rebuilt from the
+  // inherited matches, i.e. from the finer exemplar's own texels, instead of
+  // being searched from the trilinearly upsampled (blurred) coarse texture:
+  // a blurred query's nearest windows are the exemplar's smoothest ones, so
+  // the blur would persist. Measured (docs/solid.md): 2D sharpness 0.71 ->
+  // 0.88 (crackedground), 0.36 -> 0.84 (stone33) at no search cost.
+  if (!coarsest && opt.coherent_upsampling) solver.optimize(iterations, progress);
+  for (int it = 0; it < iterations; ++it) {
+    // The coarsest level has no coherent matches to start from and is
+    // small: search it exhaustively (in PCA space) until matches settle.
+    if (ctx) ctx->set_stage(stage + " search");
+    const double energy = solver.search(it, coarsest && it < 2, progress);
+    if (!std::isfinite(energy))
+      throw Error("the " + job.name + "'s energy became " + std::to_string(energy) +
+                  " (not finite) at level " + std::to_string(l + 1) + "; this is a bug, please report it with the exemplar");
+    result.energy.push_back(energy * energy_scale);
+    result.energy_level.push_back(l);
+    if (it >= optimisations) break;
+    if (ctx) ctx->set_stage(stage + " optimise");
+    solver.optimize(it, progress);
+  }
+  // Exemplar values (docs/solid.md, "Where the detail went"): the weighted
+  // mean of disagreeing windows is what blurs; the output takes the texels
+  // of the best-matching windows instead.
+  if (exemplar_values) {
+    if (ctx) ctx->set_stage(stage + " exemplar values");
+    solver.discrete(progress, &result.source);
+  }
+}
+
+TextureResult optimize_texture(const Job& job, const TextureOptimizationOptions& opt, bool wrap, ExecContext* ctx) {
+  check_options(opt);
+  const int L = opt.levels, n = opt.neighborhood;
+  PreparedExemplars ex;
+  distinct_exemplars(job, ex);
+  StageProgress prepare(ctx, job.name + ": preparing the exemplars", 0.0, 0.0, 1);
+  prepare_exemplars(job, opt, ex);
+  const int channels = ex.channels;
+  const std::vector<Dims> dims = level_dims(job.finest, L);
+
+  PyramidOptions popt;
+  popt.levels = L;
+  std::vector<std::vector<Image>> pyramids;
+  for (const Image* img : ex.images) {
+    pyramids.push_back(gaussian_pyramid(*img, popt));
+    const Image& coarsest = pyramids.back().back();
+    if (coarsest.width() < n || coarsest.height() < n)
+      throw InvalidInput("an exemplar of " + std::to_string(img->width()) + "x" + std::to_string(img->height()) +
+                         " pixels is " + std::to_string(coarsest.width()) + "x" + std::to_string(coarsest.height()) +
+                         " at the coarsest of " + std::to_string(L) + " levels, smaller than the " + std::to_string(n) + "x" +
+                         std::to_string(n) + " neighbourhood; use a larger exemplar, fewer levels or a smaller neighbourhood");
+  }
+  check_constraint(job, channels);
+  check_texture_memory(job, opt, ex);
+  std::vector<float> lo, hi;
+  value_ranges(ex.images, channels, lo, hi);
 
   std::vector<Volume> constraint_levels;
-  if (job.constraint && !job.constraint->empty()) {
+  if (ex.constraint && !ex.constraint->empty()) {
     PyramidOptions cp;
     cp.levels = L;
     cp.boundary = wrap ? Boundary::Wrap : Boundary::Clamp;
-    constraint_levels = gaussian_pyramid(*constraint_in, cp);
+    constraint_levels = gaussian_pyramid(*ex.constraint, cp);
   }
 
   // Progress: each level's share is proportional to its voxel count.
@@ -274,7 +371,7 @@ TextureResult optimize_texture(const Job& job, const TextureOptimizationOptions&
   double done = 0;
 
   // Energies are mean |s - e|^r: back in the caller's units.
-  const double energy_scale = std::pow(2.0, double(exponent) * opt.r);
+  const double energy_scale = std::pow(2.0, double(ex.exponent) * opt.r);
   TextureResult result;
   Volume tex;
   std::unique_ptr<solid::LevelSolver> previous;
@@ -287,96 +384,38 @@ TextureResult optimize_texture(const Job& job, const TextureOptimizationOptions&
     const int pyr = L - 1 - l;  // pyramid index of this level
 
     std::vector<std::unique_ptr<solid::ExemplarIndex>> index;
-    {
-      const double a0 = p0, a1 = p0 + 0.1 * (p1 - p0);
-      for (std::size_t e = 0; e < images.size(); ++e)
-        index.push_back(std::make_unique<solid::ExemplarIndex>(
-            pyramids[e][pyr], n, opt.pca_variance, opt.max_pca_dims,
-            opt.search == SolidSearch::KCoherence ? opt.coherence_k : 0, opt.histogram_bins, lo, hi, ctx,
-            stage + " exemplar analysis", a0 + (a1 - a0) * double(e) / double(images.size()),
-            a0 + (a1 - a0) * double(e + 1) / double(images.size())));
-    }
+    const double a0 = p0, a1 = p0 + 0.1 * (p1 - p0);
+    const std::size_t count = ex.images.size();
+    for (std::size_t e = 0; e < count; ++e)
+      index.push_back(std::make_unique<solid::ExemplarIndex>(
+          pyramids[e][pyr], n, opt.pca_variance, opt.max_pca_dims,
+          opt.search == SolidSearch::KCoherence ? opt.coherence_k : 0, opt.histogram_bins, lo, hi, ctx,
+          stage + " exemplar analysis", a0 + (a1 - a0) * double(e) / double(count),
+          a0 + (a1 - a0) * double(e + 1) / double(count)));
     std::array<const solid::ExemplarIndex*, 3> views{};
-    for (int i = 0; i < 3; ++i) views[i] = image_of[i] >= 0 ? index[image_of[i]].get() : nullptr;
+    for (int i = 0; i < 3; ++i) views[i] = ex.image_of[i] >= 0 ? index[ex.image_of[i]].get() : nullptr;
 
     const Dims& d = dims[l];
-    if (l == 0) {
-      // Random exemplar texels (Kopf et al. initialise from the exemplar).
-      int first_view = 0;
-      while (!views[first_view]) ++first_view;  // validated: one view is active
-      const Image& ex = views[first_view]->image();
-      tex = Volume(d.d[0], d.d[1], d.d[2], channels);
-      for (std::size_t v = 0; v < tex.voxel_count(); ++v) {
-        IndexRng rng(opt.seed, v, 0x1417);
-        const std::size_t pix = rng.below(ex.pixel_count());
-        std::copy(ex.data() + pix * channels, ex.data() + (pix + 1) * channels, tex.data() + v * channels);
-      }
-    } else {
-      tex = resize_trilinear(tex, d.d[0], d.d[1], d.d[2], wrap ? Boundary::Wrap : Boundary::Clamp);
-    }
-
+    tex = l == 0 ? random_texels(d, views, channels, opt.seed)
+                 : resize_trilinear(tex, d.d[0], d.d[1], d.d[2], wrap ? Boundary::Wrap : Boundary::Clamp);
     const Volume& constraint = constraint_levels.empty() ? empty : constraint_levels[pyr];
     auto solver = std::make_unique<solid::LevelSolver>(tex, views, constraint, opt, wrap,
                                                        hash_index(opt.seed, std::uint64_t(l), 0x5EED), lo, hi);
-    const bool coarsest = l == 0;
-    if (!coarsest) solver->inherit_matches(*previous);
-
-    const bool finest = l == L - 1;
-    // finest_iterations applies from two levels on (a single level is also
-    // the coarsest, which needs its 2x to converge).
-    const int iterations = coarsest ? 2 * opt.iterations : finest ? finest_rounds(opt, d) : opt.iterations;
-    const bool exemplar_values = finest && opt.exemplar_values;
-    // With exemplar values the finest level's last optimisation would be
-    // overwritten voxel for voxel: the pass reads only the matches and
-    // weights of the last search, and a voxel it leaves (no covering window)
-    // is one the optimisation leaves too. So it is skipped (same output;
-    // measured 2.1 s of 28.6 s CPU at 128^3).
-    const int optimisations = exemplar_values ? iterations - 1 : iterations;
-    StageProgress progress(ctx, stage, p0 + 0.1 * (p1 - p0), p1,
-                           std::size_t(iterations) * solver->search_units() +
-                               std::size_t(optimisations) * solver->optimize_units() +
-                               (!coarsest && opt.coherent_upsampling ? solver->optimize_units() : 0) +
-                               (exemplar_values ? solver->discrete_units() : 0));
-    // Coherent upsampling: the finer level's texture is first rebuilt from the
-    // inherited matches, i.e. from the finer exemplar's own texels, instead of
-    // being searched from the trilinearly upsampled (blurred) coarse texture:
-    // a blurred query's nearest windows are the exemplar's smoothest ones, so
-    // the blur would persist. Measured (docs/solid.md): 2D sharpness 0.71 ->
-    // 0.88 (crackedground), 0.36 -> 0.84 (stone33) at no search cost.
-    if (!coarsest && opt.coherent_upsampling) solver->optimize(iterations, progress);
-    for (int it = 0; it < iterations; ++it) {
-      // The coarsest level has no coherent matches to start from and is
-      // small: search it exhaustively (in PCA space) until matches settle.
-      if (ctx) ctx->set_stage(stage + " search");
-      const double energy = solver->search(it, coarsest && it < 2, progress);
-      if (!std::isfinite(energy))
-        throw Error("the " + job.name + "'s energy became " + std::to_string(energy) +
-                    " (not finite) at level " + std::to_string(l + 1) + "; this is a bug, please report it with the exemplar");
-      result.energy.push_back(energy * energy_scale);
-      result.energy_level.push_back(l);
-      if (it >= optimisations) break;
-      if (ctx) ctx->set_stage(stage + " optimise");
-      solver->optimize(it, progress);
-    }
-    // Exemplar values (docs/solid.md, "Where the detail went"): the weighted
-    // mean of disagreeing windows is what blurs; the output takes the texels
-    // of the best-matching windows instead.
-    if (exemplar_values) {
-      if (ctx) ctx->set_stage(stage + " exemplar values");
-      solver->discrete(progress, &result.source);
-    }
+    if (l > 0) solver->inherit_matches(*previous);
+    optimize_level(*solver, job, opt, d, l, energy_scale, p0, p1, ctx, result);
     previous = std::move(solver);
     prev_index = std::move(index);  // the solver's views point into these
   }
   if (ctx) ctx->set_progress(1.0);
-  if (channels != user_channels) {  // drop the feature-distance channel
+  if (channels != ex.user_channels) {  // drop the feature-distance channel
+    const int user_channels = ex.user_channels;
     Volume out(tex.nx(), tex.ny(), tex.nz(), user_channels, 0.0f, tex.transform());
     for (std::size_t v = 0; v < tex.voxel_count(); ++v)
       std::copy(tex.data() + v * channels, tex.data() + v * channels + user_channels, out.data() + v * user_channels);
     tex = std::move(out);
   }
-  if (exponent != 0)
-    for (float& v : tex.values()) v = std::ldexp(v, exponent);
+  if (ex.exponent != 0)
+    for (float& v : tex.values()) v = std::ldexp(v, ex.exponent);
   result.texture = std::move(tex);
   return result;
 }
