@@ -63,7 +63,11 @@ def strokes(vertices, normals, field, indices, length, lift):
     """Segments (2 k, 3) float32, tail then head for each drawable vertex of
     `indices`, the tail at the vertex lifted by `lift` along its normal (so
     the surface does not hide it), the head `length` along the field."""
-    idx = drawable(field, indices)
+    return drawable_strokes(vertices, normals, field, drawable(field, indices), length, lift)
+
+
+def drawable_strokes(vertices, normals, field, idx, length, lift):
+    """`strokes` for indices already filtered by `drawable`."""
     tail = np.asarray(vertices, np.float64)[idx] + lift * np.asarray(normals, np.float64)[idx]
     head = tail + length * normalized(np.asarray(field, np.float64)[idx])
     seg = np.empty((2 * len(idx), 3), np.float32)

@@ -119,9 +119,10 @@ def geometry(obj, settings):
     topo = _cache["topology"]
     idx, spacing = topo["strokes"]
     lift = 0.05 * topo["edge"]
-    out = {"segments": field_glyphs.strokes(co, topo["normals"], field, idx,
-                                            settings.field_overlay_length * spacing, lift),
-           "segment_normals": topo["normals"][field_glyphs.drawable(field, idx)]}
+    drawn = field_glyphs.drawable(field, idx)
+    out = {"segments": field_glyphs.drawable_strokes(co, topo["normals"], field, drawn,
+                                                     settings.field_overlay_length * spacing, lift),
+           "segment_normals": topo["normals"][drawn]}
     deferred = stroking and len(co) > LIVE_SINGULARITY_LIMIT
     if settings.field_overlay_singularities and len(tris) and not deferred:
         out.update(field_glyphs.singular_points(co, tris, field, topo["normals"], lift, edges=topo["edges"]))
