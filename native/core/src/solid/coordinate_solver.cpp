@@ -1,6 +1,7 @@
 #include "solid/coordinate_solver.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <limits>
 
 #include "exsynth/parallel.hpp"
@@ -240,6 +241,163 @@ std::array<float, 3> CoordinateSolver::view_costs(const std::array<int, 3>& p) c
       }
   }
   return cost;
+}
+
+std::array<std::array<double, 3>, 3> CoordinateSolver::repeat_fractions() const {
+  std::array<std::array<double, 3>, 3> out{};
+  for (int i = 0; i < 3; ++i) {
+    if (!views_[i]) continue;
+    for (int axis = 0; axis < 3; ++axis) {
+      std::size_t same = 0, n = 0;
+      for (int z = 0; z < dims_[2]; ++z)
+        for (int y = 0; y < dims_[1]; ++y)
+          for (int x = 0; x < dims_[0]; ++x) {
+            std::array<int, 3> q{x, y, z};
+            if (++q[axis] >= dims_[axis]) continue;
+            const std::int32_t a = coords_[voxel(x, y, z)][i], b = coords_[voxel(q[0], q[1], q[2])][i];
+            const std::int32_t expect = axis == i ? a : axis == col_axis(i) ? shift(i, a, 1, 0) : shift(i, a, 0, 1);
+            same += b == expect;
+            ++n;
+          }
+      out[i][axis] = n ? double(same) / double(n) : 0.0;
+    }
+  }
+  return out;
+}
+
+std::pair<std::int8_t, std::int32_t> CoordinateSolver::medoid(const std::array<int, 3>& p) const {
+  // Proposals: for each view i and each voxel q of p's 3x3 window in slice
+  // i, q's witness moved back by q's offset (the texel q's exemplar window
+  // puts at p). The shown value is the proposal nearest (sum of Euclidean
+  // distances) to all of them: an exemplar texel, not their mean (which
+  // blurs), and what most views agree on.
+  std::array<std::pair<std::int8_t, std::int32_t>, 27> prop{};
+  int n = 0;
+  for (int i = 0; i < 3; ++i) {
+    if (!views_[i]) continue;
+    const int a = col_axis(i), b = row_axis(i);
+    for (int dv = -1; dv <= 1; ++dv)
+      for (int du = -1; du <= 1; ++du) {
+        std::array<int, 3> q = p;
+        q[a] += du;
+        q[b] += dv;
+        bool inside = true;
+        for (int ax : {a, b})
+          if (q[ax] < 0 || q[ax] >= dims_[ax]) {
+            if (!wrap_) inside = false;
+            q[ax] = (q[ax] + dims_[ax]) % dims_[ax];
+          }
+        if (!inside) continue;
+        prop[std::size_t(n++)] = {std::int8_t(i), shift(i, coords_[voxel(q[0], q[1], q[2])][i], -du, -dv)};
+      }
+  }
+  const int channels = views_[prop[0].first]->image().channels();
+  float best = std::numeric_limits<float>::max();
+  int pick = 0;
+  for (int k = 0; k < n; ++k) {
+    const float* c = colour(prop[k].first, prop[k].second);
+    float cost = 0.0f;
+    for (int m = 0; m < n && cost < best; ++m) {
+      if (m == k) continue;
+      const float* d = colour(prop[m].first, prop[m].second);
+      float e = 0.0f;
+      for (int ch = 0; ch < channels; ++ch) e += (c[ch] - d[ch]) * (c[ch] - d[ch]);
+      cost += std::sqrt(e);
+    }
+    if (cost < best) {
+      best = cost;
+      pick = k;
+    }
+  }
+  return prop[std::size_t(pick)];
+}
+
+std::int32_t CoordinateSolver::witness(const std::array<int, 3>& p, int view) const {
+  const ExemplarIndex& ix = *views_[view];
+  const Image& img = ix.image();
+  const int channels = img.channels();
+  const int a = col_axis(view), b = row_axis(view);
+  // The shown values of p's 3x3 window in this view's slice (nullptr outside).
+  std::array<const float*, 9> shown{};
+  std::array<std::int32_t, 10> cand{};
+  int n = 0;
+  cand[std::size_t(n++)] = coords_[voxel(p[0], p[1], p[2])][view];
+  for (int dv = -1; dv <= 1; ++dv)
+    for (int du = -1; du <= 1; ++du) {
+      std::array<int, 3> q = p;
+      q[a] += du;
+      q[b] += dv;
+      bool inside = true;
+      for (int ax : {a, b})
+        if (q[ax] < 0 || q[ax] >= dims_[ax]) {
+          if (!wrap_) inside = false;
+          q[ax] = (q[ax] + dims_[ax]) % dims_[ax];
+        }
+      if (!inside) continue;
+      const std::size_t w = voxel(q[0], q[1], q[2]);
+      shown[std::size_t((dv + 1) * 3 + du + 1)] = colour(shown_[w].first, shown_[w].second);
+      if (du != 0 || dv != 0) cand[std::size_t(n++)] = shift(view, coords_[w][view], -du, -dv);
+    }
+  float best = std::numeric_limits<float>::max();
+  std::int32_t pick = cand[0];
+  for (int k = 0; k < n; ++k) {
+    if (k > 0 && std::find(cand.begin(), cand.begin() + k, cand[std::size_t(k)]) != cand.begin() + k) continue;
+    const int u = ix.centre_u(cand[std::size_t(k)]), v = ix.centre_v(cand[std::size_t(k)]);
+    float cost = 0.0f;
+    for (int dv = -1; dv <= 1 && cost < best; ++dv)
+      for (int du = -1; du <= 1; ++du) {
+        const float* s = shown[std::size_t((dv + 1) * 3 + du + 1)];
+        if (!s) continue;
+        const float* e = img.data() + img.offset(u + du, v + dv);  // inside: valid centres have 5x5 windows
+        for (int ch = 0; ch < channels; ++ch) cost += (s[ch] - e[ch]) * (s[ch] - e[ch]);
+      }
+    if (cost < best) {
+      best = cost;
+      pick = cand[std::size_t(k)];
+    }
+  }
+  return pick;
+}
+
+void CoordinateSolver::choose_shown(StageProgress& progress) {
+  shown_.resize(coords_.size());
+  parallel_chunks(coords_.size(), 1 << 12, progress, [&](std::size_t v0, std::size_t v1) {
+    for (std::size_t v = v0; v < v1; ++v)
+      shown_[v] = medoid({int(v % dims_[0]), int(v / dims_[0] % dims_[1]), int(v / dims_[0] / dims_[1])});
+  });
+}
+
+void CoordinateSolver::refine(int rounds, StageProgress& progress) {
+  // Jacobi steps (each reads only what the other writes): parallel and the
+  // same on any thread count.
+  std::vector<Triple> next(coords_.size());
+  for (int r = 0; r < rounds; ++r) {
+    choose_shown(progress);
+    parallel_chunks(coords_.size(), 1 << 12, progress, [&](std::size_t v0, std::size_t v1) {
+      for (std::size_t v = v0; v < v1; ++v) {
+        const std::array<int, 3> p{int(v % dims_[0]), int(v / dims_[0] % dims_[1]), int(v / dims_[0] / dims_[1])};
+        for (int i = 0; i < 3; ++i) next[v][i] = views_[i] ? witness(p, i) : -1;
+      }
+    });
+    coords_.swap(next);
+  }
+  choose_shown(progress);
+}
+
+Volume CoordinateSolver::shown_colours(const std::array<const Image*, 3>& images, StageProgress& progress) const {
+  int channels = 0;
+  for (int i = 0; i < 3; ++i)
+    if (views_[i]) channels = images[i]->channels();
+  Volume out(dims_[0], dims_[1], dims_[2], channels);
+  parallel_chunks(coords_.size(), 1 << 12, progress, [&](std::size_t v0, std::size_t v1) {
+    for (std::size_t v = v0; v < v1; ++v) {
+      const int i = shown_[v].first;
+      const std::int32_t j = shown_[v].second;
+      const float* src = images[i]->data() + images[i]->offset(views_[i]->centre_u(j), views_[i]->centre_v(j));
+      std::copy(src, src + channels, out.data() + v * channels);
+    }
+  });
+  return out;
 }
 
 Volume CoordinateSolver::colours(const std::array<const Image*, 3>& images, StageProgress& progress) const {

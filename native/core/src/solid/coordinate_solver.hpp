@@ -34,6 +34,13 @@ class CoordinateSolver {
   void upsample(const CoordinateSolver& coarser, StageProgress& progress);
   /// One correction pass over every voxel (sub-passes by parity).
   void correct(StageProgress& progress);
+  /// Discrete 3-slice refinement on displayed values (Kopf et al. 2007's
+  /// energy with exemplar texels for values): `rounds` times, each voxel
+  /// shows the medoid of what the three views' witnesses around it propose
+  /// for it, then each view's texel (its witness) becomes the candidate whose
+  /// exemplar window best matches the shown values in that view's slice.
+  /// Ends with the shown values chosen again. Reports units() per round.
+  void refine(int rounds, StageProgress& progress);
   /// Units of progress initialize, upsample and correct each report.
   std::size_t units() const { return coords_.size(); }
 
@@ -41,7 +48,13 @@ class CoordinateSolver {
   /// that fits its neighbours best, read from `images` (the views' exemplars at this level's
   /// resolution, nullptr = inactive; any channel count, same per view).
   Volume colours(const std::array<const Image*, 3>& images, StageProgress& progress) const;
+  /// Per voxel: the shown values after refine() (same reading as colours()).
+  Volume shown_colours(const std::array<const Image*, 3>& images, StageProgress& progress) const;
   const std::vector<Triple>& coordinates() const { return coords_; }
+  /// [view][axis]: fraction of voxels whose texel in that view equals their
+  /// +1 neighbour's along that axis (own axis: the same texel, an extrusion;
+  /// slice axes: the neighbour's texel is this one moved by one, coherence).
+  std::array<std::array<double, 3>, 3> repeat_fractions() const;
   /// Mean over voxels of the best candidate's cost after the last pass.
   double energy() const { return energy_; }
 
@@ -55,6 +68,16 @@ class CoordinateSolver {
   const float* feature(int view, std::int32_t j) const { return features_[view] + std::size_t(j) * dims_pca_[view]; }
   /// Per view: how far the voxel's texel's crossbar neighbourhood is from its neighbours' texels.
   std::array<float, 3> view_costs(const std::array<int, 3>& p) const;
+  /// Exemplar value (this level's analysis image) of valid centre j of view i.
+  const float* colour(int view, std::int32_t j) const {
+    const Image& img = views_[view]->image();
+    return img.data() + img.offset(views_[view]->centre_u(j), views_[view]->centre_v(j));
+  }
+  /// The medoid of the texels the witnesses of p's 3x3 slice windows propose for p.
+  std::pair<std::int8_t, std::int32_t> medoid(const std::array<int, 3>& p) const;
+  /// The best witness of view i at p for the shown values of its slice window.
+  std::int32_t witness(const std::array<int, 3>& p, int view) const;
+  void choose_shown(StageProgress& progress);
   /// Corrects one voxel; returns its cost.
   float correct_voxel(const std::array<int, 3>& p, std::vector<Triple>& candidates, Triple& best) const;
 
@@ -70,6 +93,8 @@ class CoordinateSolver {
   std::array<const float*, 3> features_{};
   std::array<int, 3> dims_pca_{};
   std::vector<Triple> coords_;
+  // After refine(): per voxel the view and texel it shows.
+  std::vector<std::pair<std::int8_t, std::int32_t>> shown_;
   double energy_ = 0.0;
 };
 
