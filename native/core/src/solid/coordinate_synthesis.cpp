@@ -204,18 +204,11 @@ TextureResult synthesize_coordinates(const std::array<const Image*, 3>& view_ima
       result.energy.push_back(solver->energy() * std::ldexp(1.0, 2 * exponent));
       result.energy_level.push_back(l);
     }
-    static const int refine_rounds = std::getenv("EXSYNTH_REFINE") ? std::atoi(std::getenv("EXSYNTH_REFINE")) : 0;  // DIAG
-    static const bool coarse_only = std::getenv("EXSYNTH_REFINE_COARSE") != nullptr;  // DIAG
-    const bool refining = refine_rounds > 0 && !(coarse_only && l == L - 1);
-    if (refining) {
-      solver->refine(refine_rounds, progress);
-      diag("refine");
-    }
     if (l == L - 1) {
       if (ctx) ctx->set_stage("solid: colours");
       std::array<const Image*, 3> images{};
       for (int i = 0; i < 3; ++i) images[i] = image_of[i] >= 0 ? &working[std::size_t(image_of[i])] : nullptr;
-      result.texture = refining ? solver->shown_colours(images, progress) : solver->colours(images, progress);
+      result.texture = solver->colours(images, progress);
     }
     previous = std::move(solver);
     prev_table = std::move(table);  // the solver refers to these
