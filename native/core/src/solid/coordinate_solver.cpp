@@ -1,15 +1,7 @@
 #include "solid/coordinate_solver.hpp"
 
 #include <algorithm>
-#include <cmath>
-#include <atomic>
-#include <cstdio>
-#include <cstdlib>
 #include <limits>
-
-#include <tbb/blocked_range.h>
-#include <tbb/parallel_for.h>
-#include <tbb/partitioner.h>
 
 #include "exsynth/parallel.hpp"
 #include "exsynth/rng.hpp"
@@ -21,24 +13,6 @@ namespace {
 /// except that with an odd n and wrapping, the last voxel (a neighbour of
 /// voxel 0 and of n - 2) gets a class of its own.
 constexpr int kInitCell = 8;
-constexpr float kDisplayWeight = 8.0f;
-
-float squared_distance(const float* a, const float* b, int n) {
-  float d = 0.0f;
-  for (int c = 0; c < n; ++c) d += (a[c] - b[c]) * (a[c] - b[c]);
-  return d;
-}
-
-// Distance of displayed values: robust, so a voxel shows the value most of
-// its neighbours predict rather than their mean (squared distances pulled
-// the solid to the exemplar's flattest texels).
-float display_distance(const float* a, const float* b, int n) {
-  static const int mode = std::getenv("EXSYNTH_DISPLAY_MODE") ? std::atoi(std::getenv("EXSYNTH_DISPLAY_MODE")) : 1;  // DIAG
-  const float d = squared_distance(a, b, n);
-  if (mode == 0) return d;
-  if (mode == 1) return std::sqrt(d);
-  return std::min(d, 0.01f);  // truncated
-}
 
 int parity_class(int x, int n, bool wrap) { return wrap && (n & 1) && x == n - 1 ? 2 : (x & 1); }
 
@@ -46,23 +20,13 @@ int parity_class(int x, int n, bool wrap) { return wrap && (n & 1) && x == n - 1
 
 CoordinateSolver::CoordinateSolver(const std::array<int, 3>& dims, const std::array<const ExemplarIndex*, 3>& views,
                                    const CrossbarCandidates& candidates, int coherence_k, bool wrap, std::uint64_t seed)
-    : dims_(dims), views_(views), table_(candidates), k_(coherence_k),
-      display_weight_(std::getenv("EXSYNTH_DISPLAY_WEIGHT") ? float(std::atof(std::getenv("EXSYNTH_DISPLAY_WEIGHT"))) : kDisplayWeight),  // DIAG
-      wrap_(wrap), seed_(seed),
-      coords_(std::size_t(dims[0]) * dims[1] * dims[2], Triple{-1, -1, -1}),
-      display_(std::size_t(dims[0]) * dims[1] * dims[2], 0) {
+    : dims_(dims), views_(views), table_(candidates), k_(coherence_k), wrap_(wrap), seed_(seed),
+      coords_(std::size_t(dims[0]) * dims[1] * dims[2], Triple{-1, -1, -1}) {
   for (int i = 0; i < 3; ++i)
     if (views_[i]) {
       features_[i] = views_[i]->coefficients().data();
       dims_pca_[i] = int(views_[i]->coefficients().cols());
       k_ = std::min(k_, views_[i]->coherence_k());
-      const Image& img = views_[i]->image();
-      channels_ = img.channels();
-      colours_[i].resize(std::size_t(views_[i]->count()) * channels_);
-      for (int j = 0; j < views_[i]->count(); ++j) {
-        const float* src = img.data() + img.offset(views_[i]->centre_u(j), views_[i]->centre_v(j));
-        std::copy(src, src + channels_, colours_[i].data() + std::size_t(j) * channels_);
-      }
     }
 }
 
@@ -109,7 +73,6 @@ void CoordinateSolver::initialize(StageProgress& progress) {
       coords_[v] = t;
     }
   });
-  choose_displays(progress);
 }
 
 void CoordinateSolver::upsample(const CoordinateSolver& coarser, StageProgress& progress) {
@@ -131,87 +94,19 @@ void CoordinateSolver::upsample(const CoordinateSolver& coarser, StageProgress& 
     }
     progress.advance((r1 - r0) * std::size_t(dims_[0]) - (r1 - r0));
   });
-  choose_displays(progress);
 }
 
-CoordinateSolver::Predictions CoordinateSolver::predictions(const std::array<int, 3>& p) const {
-  Predictions pred;
-  for (int axis = 0; axis < 3; ++axis)
-    for (int s = 0; s < 2; ++s) {
-      const std::int64_t w = neighbour(p, axis, s ? 1 : -1);
-      if (w < 0) continue;
-      const int step = s ? 1 : -1;
-      for (int i = 0; i < 3; ++i) {
-        if (!views_[i] || axis == i) continue;
-        const std::int32_t there = coords_[std::size_t(w)][i];
-        const std::int32_t back = axis == col_axis(i) ? shift(i, there, -step, 0) : shift(i, there, 0, -step);
-        pred.value[std::size_t(pred.n++)] = colour(i, back);
-      }
-    }
-  return pred;
-}
-
-float CoordinateSolver::display_cost(const Triple& t, const Predictions& pred, int& view) const {
-  float best = std::numeric_limits<float>::max();
-  view = -1;
-  static const int fixed = std::getenv("EXSYNTH_DISPLAY_FIXED") ? std::atoi(std::getenv("EXSYNTH_DISPLAY_FIXED")) : -1;  // DIAG
-  for (int v = 0; v < 3; ++v) {
-    if (!views_[v] || (fixed >= 0 && v != fixed)) continue;
-    const float* c = colour(v, t[v]);
-    float cost = 0.0f;
-    for (int i = 0; i < 3; ++i)
-      if (views_[i] && i != v) cost += display_distance(colour(i, t[i]), c, channels_);
-    for (int k = 0; k < pred.n; ++k) cost += display_distance(pred.value[std::size_t(k)], c, channels_);
-    if (cost < best) {
-      best = cost;
-      view = v;
-    }
-  }
-  return best;
-}
-
-void CoordinateSolver::choose_displays(const StageProgress& progress) {
-  auto run = [&](std::size_t v0, std::size_t v1) {
-    for (std::size_t v = v0; v < v1; ++v) {
-      const std::array<int, 3> p{int(v % dims_[0]), int(v / dims_[0] % dims_[1]), int(v / dims_[0] / dims_[1])};
-      int view = 0;
-      static const bool old = std::getenv("EXSYNTH_OLD_OUTPUT") != nullptr;  // DIAG
-      if (old) {
-        const std::array<float, 3> cost = view_costs(p);
-        view = -1;
-        for (int i = 0; i < 3; ++i)
-          if (views_[i] && (view < 0 || cost[i] < cost[view])) view = i;
-      } else {
-        display_cost(coords_[v], predictions(p), view);
-      }
-      display_[v] = std::int8_t(view);
-    }
-  };
-  // Checks for cancel per chunk but reports no progress (the caller's
-  // stage counted its units for the pass that comes with it).
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, coords_.size(), 1 << 12),
-                    [&](const tbb::blocked_range<std::size_t>& r) {
-                      progress.check();
-                      run(r.begin(), r.end());
-                    },
-                    tbb::simple_partitioner());
-}
-
-float CoordinateSolver::correct_voxel(const std::array<int, 3>& p, std::vector<Triple>& candidates, Triple& best,
-                                      std::int8_t& best_view) const {
+float CoordinateSolver::correct_voxel(const std::array<int, 3>& p, std::vector<Triple>& candidates, Triple& best) const {
   // The neighbours' features: per active view, its four crossbar neighbours
-  // in the slice (dir 0/1: -/+ along the columns, 2/3: along the rows), and
-  // the value each neighbour displays.
+  // in the slice (dir 0/1: -/+ along the columns, 2/3: along the rows).
   struct Target {
-    const float* f = nullptr;      // neighbour's feature in this view (nullptr: outside)
-    const float* shown = nullptr;  // the value the neighbour displays
-    int du = 0, dv = 0;            // its offset in the exemplar
+    const float* f = nullptr;  // neighbour's feature in this view (nullptr: outside)
+    int du = 0, dv = 0;        // its offset in the exemplar
   };
   std::array<std::array<Target, 4>, 3> targets{};
   std::array<std::int64_t, 6> nb{};  // face neighbours: axis * 2 + (s > 0)
   for (int axis = 0; axis < 3; ++axis)
     for (int s = 0; s < 2; ++s) nb[axis * 2 + s] = neighbour(p, axis, s ? 1 : -1);
-  const Predictions pred = predictions(p);
 
   candidates.clear();
   auto add = [&](const Triple& t) { candidates.push_back(t); };
@@ -226,20 +121,7 @@ float CoordinateSolver::correct_voxel(const std::array<int, 3>& p, std::vector<T
         if (!views_[i] || axis == i) continue;
         t[i] = axis == col_axis(i) ? shift(i, t[i], -step, 0) : shift(i, t[i], 0, -step);
       }
-      static const bool rederive = std::getenv("EXSYNTH_REDERIVE") != nullptr;  // DIAG
-      if (!rederive || !views_[axis]) {
-        add(t);
-        continue;
-      }
-      // The view whose own axis the step runs along: its texel re-derived
-      // from each other view's moved texel (the table's best triple holding
-      // it), not kept (which would extrude it along that axis for free).
-      for (int j = 0; j < 3; ++j) {
-        if (!views_[j] || j == axis) continue;
-        Triple u = t;
-        u[axis] = table_.of(j, t[j])[0][axis];
-        add(u);
-      }
+      add(t);
     }
   // Per view: the neighbours' texels moved back (k-coherence) and their
   // k most similar texels, each with its crossbar triples.
@@ -253,7 +135,7 @@ float CoordinateSolver::correct_voxel(const std::array<int, 3>& p, std::vector<T
         const int step = s ? 1 : -1;
         const int du = a == 0 ? step : 0, dv = a == 1 ? step : 0;
         const std::int32_t there = coords_[std::size_t(w)][i];
-        targets[i][a * 2 + s] = {feature(i, there), displayed(std::size_t(w)), du, dv};
+        targets[i][a * 2 + s] = {feature(i, there), du, dv};
         const std::int32_t q = shift(i, there, -du, -dv);
         for (int r = 0; r < table_.per_texel(); ++r) add(table_.of(i, q)[r]);
         if (k_ == 0) continue;
@@ -279,33 +161,27 @@ float CoordinateSolver::correct_voxel(const std::array<int, 3>& p, std::vector<T
       for (int b = a + 1; b < 3; ++b) {
         if (!views_[a] || !views_[b]) continue;
         const int axis = shared_axis(a, b);
-        cost += consistency_ * squared_distance(table_.line(a, axis, t[a]), table_.line(b, axis, t[b]), line_dims);
+        const float* la = table_.line(a, axis, t[a]);
+        const float* lb = table_.line(b, axis, t[b]);
+        float d = 0.0f;
+        for (int c = 0; c < line_dims; ++c) d += (la[c] - lb[c]) * (la[c] - lb[c]);
+        cost += consistency_ * d;
       }
-    // Displayed colours (Kopf's 3-slice energy on the values shown): the
-    // value this voxel shows against its other texels and its neighbours'
-    // predictions of it, and each view's texel's neighbours against what the
-    // neighbours show. Without it each view's texel may repeat along its
-    // own axis at no cost, and the shown solid is an extrusion.
-    int view = 0;
-    float shown = display_cost(t, pred, view);
-    for (int i = 0; i < 3; ++i) {
-      if (!views_[i]) continue;
-      for (const Target& tg : targets[i])
-        if (tg.f) shown += display_distance(colour(i, shift(i, t[i], tg.du, tg.dv)), tg.shown, channels_);
-    }
-    cost += display_weight_ * shown;
     for (int i = 0; i < 3 && cost < best_cost; ++i) {
       if (!views_[i]) continue;
       const int d = dims_pca_[i];
       for (const Target& tg : targets[i]) {
         if (!tg.f) continue;
-        cost += squared_distance(feature(i, shift(i, t[i], tg.du, tg.dv)), tg.f, d);
+        const float* f = feature(i, shift(i, t[i], tg.du, tg.dv));
+        for (int c = 0; c < d; ++c) {
+          const float e = f[c] - tg.f[c];
+          cost += e * e;
+        }
       }
     }
     if (cost < best_cost) {
       best_cost = cost;
       best = t;
-      best_view = std::int8_t(view);
     }
   }
   return best_cost;
@@ -333,12 +209,9 @@ void CoordinateSolver::correct(StageProgress& progress) {
             for (int x = 0; x < dims_[0]; ++x) {
               if (parity_class(x, dims_[0], wrap_) != cx) continue;
               const std::array<int, 3> p{x, rows[r][0], rows[r][1]};
-              const std::size_t v = voxel(p[0], p[1], p[2]);
-              Triple best = coords_[v];
-              std::int8_t view = display_[v];
-              row_cost[r] += correct_voxel(p, candidates, best, view);
-              coords_[v] = best;
-              display_[v] = view;
+              Triple best = coords_[voxel(p[0], p[1], p[2])];
+              row_cost[r] += correct_voxel(p, candidates, best);
+              coords_[voxel(p[0], p[1], p[2])] = best;
               ++done;
             }
           }
@@ -369,49 +242,26 @@ std::array<float, 3> CoordinateSolver::view_costs(const std::array<int, 3>& p) c
   return cost;
 }
 
-std::array<std::array<double, 3>, 3> CoordinateSolver::repeat_fractions() const {
-  std::array<std::array<double, 3>, 3> out{};
-  for (int i = 0; i < 3; ++i) {
-    if (!views_[i]) continue;
-    for (int axis = 0; axis < 3; ++axis) {
-      std::size_t same = 0, n = 0;
-      for (int z = 0; z < dims_[2]; ++z)
-        for (int y = 0; y < dims_[1]; ++y)
-          for (int x = 0; x < dims_[0]; ++x) {
-            std::array<int, 3> q{x, y, z};
-            if (++q[axis] >= dims_[axis]) continue;
-            const std::int32_t a = coords_[voxel(x, y, z)][i], b = coords_[voxel(q[0], q[1], q[2])][i];
-            const std::int32_t expect = axis == i ? a : axis == col_axis(i) ? shift(i, a, 1, 0) : shift(i, a, 0, 1);
-            same += b == expect;
-            ++n;
-          }
-      out[i][axis] = n ? double(same) / double(n) : 0.0;
-    }
-  }
-  return out;
-}
-
-static std::atomic<long> diag_picks[3];  // DIAG
-Volume CoordinateSolver::colours(const std::array<const Image*, 3>& images, StageProgress& progress) {
+Volume CoordinateSolver::colours(const std::array<const Image*, 3>& images, StageProgress& progress) const {
   int channels = 0;
   for (int i = 0; i < 3; ++i)
     if (views_[i]) channels = images[i]->channels();
   Volume out(dims_[0], dims_[1], dims_[2], channels);
-  // Each voxel shows the texel of the view that best fits its other texels
-  // and its neighbours' predictions (the three texels' mean blurs wherever
-  // the triple's views disagree), chosen again from the final coordinates.
-  choose_displays(progress);
+  // Each voxel takes the texel of the view whose slice neighbourhood agrees
+  // best with its neighbours' (the three texels' mean blurs wherever the
+  // triple's views disagree).
   parallel_chunks(coords_.size(), 1 << 12, progress, [&](std::size_t v0, std::size_t v1) {
     for (std::size_t v = v0; v < v1; ++v) {
-      const int pick = display_[v];
+      const std::array<int, 3> p{int(v % dims_[0]), int(v / dims_[0] % dims_[1]), int(v / dims_[0] / dims_[1])};
+      const std::array<float, 3> cost = view_costs(p);
+      int pick = -1;
+      for (int i = 0; i < 3; ++i)
+        if (views_[i] && (pick < 0 || cost[i] < cost[pick])) pick = i;
       const std::int32_t j = coords_[v][pick];
-      diag_picks[pick]++;  // DIAG
       const float* src = images[pick]->data() + images[pick]->offset(views_[pick]->centre_u(j), views_[pick]->centre_v(j));
       std::copy(src, src + channels, out.data() + v * channels);
     }
   });
-  if (std::getenv("EXSYNTH_DIAG_SOLID"))
-    std::fprintf(stderr, "output picks x %ld y %ld z %ld\n", diag_picks[0].exchange(0), diag_picks[1].exchange(0), diag_picks[2].exchange(0));
   return out;
 }
 

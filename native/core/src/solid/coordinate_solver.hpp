@@ -40,12 +40,8 @@ class CoordinateSolver {
   /// Per voxel (x fastest): the exemplar values of its texel in the view
   /// that fits its neighbours best, read from `images` (the views' exemplars at this level's
   /// resolution, nullptr = inactive; any channel count, same per view).
-  Volume colours(const std::array<const Image*, 3>& images, StageProgress& progress);
+  Volume colours(const std::array<const Image*, 3>& images, StageProgress& progress) const;
   const std::vector<Triple>& coordinates() const { return coords_; }
-  /// [view][axis]: fraction of voxels whose texel in that view equals their
-  /// +1 neighbour's along that axis (own axis: the same texel, an extrusion;
-  /// slice axes: the neighbour's texel is this one moved by one, coherence).
-  std::array<std::array<double, 3>, 3> repeat_fractions() const;
   /// Mean over voxels of the best candidate's cost after the last pass.
   double energy() const { return energy_; }
 
@@ -57,28 +53,10 @@ class CoordinateSolver {
   /// Texel of valid centre j of view i moved by (du, dv), clamped to valid centres.
   std::int32_t shift(int view, std::int32_t j, int du, int dv) const;
   const float* feature(int view, std::int32_t j) const { return features_[view] + std::size_t(j) * dims_pca_[view]; }
+  /// Per view: how far the voxel's texel's crossbar neighbourhood is from its neighbours' texels.
   std::array<float, 3> view_costs(const std::array<int, 3>& p) const;
-  /// Exemplar value (this level's analysis image) of valid centre j of view i.
-  const float* colour(int view, std::int32_t j) const { return colours_[view].data() + std::size_t(j) * channels_; }
-  /// Displayed value of voxel v: its texel in the view it shows.
-  const float* displayed(std::size_t v) const { return colour(display_[v], coords_[v][display_[v]]); }
-  /// What the face neighbours' texels say voxel p shows: per neighbour q and
-  /// each view whose slice holds both, q's texel moved back by the step
-  /// (up to 2 views x 6 neighbours).
-  struct Predictions {
-    std::array<const float*, 12> value{};
-    int n = 0;
-  };
-  Predictions predictions(const std::array<int, 3>& p) const;
-  /// Displayed-colour cost of showing view v's texel of triple t at a voxel
-  /// with neighbours' predictions `pred`: its distance to t's other texels
-  /// and to the predictions. Returns the best view in `view`.
-  float display_cost(const Triple& t, const Predictions& pred, int& view) const;
-  /// Sets every voxel's displayed view from the coordinates (parallel).
-  void choose_displays(const StageProgress& progress);
   /// Corrects one voxel; returns its cost.
-  float correct_voxel(const std::array<int, 3>& p, std::vector<Triple>& candidates, Triple& best,
-                      std::int8_t& best_view) const;
+  float correct_voxel(const std::array<int, 3>& p, std::vector<Triple>& candidates, Triple& best) const;
 
   std::array<int, 3> dims_;
   std::array<const ExemplarIndex*, 3> views_;
@@ -87,17 +65,11 @@ class CoordinateSolver {
   // Weight of the crossbar consistency against the neighbourhood match: 1
   // gave crisper 32^3 stone33 slices than 4 or 16 (docs/solid.md).
   const float consistency_ = 1.0f;
-  // Weight of the displayed-colour terms (per value, against the 5x5
-  // neighbourhoods' squared PCA distances): see docs/solid.md.
-  const float display_weight_;
-  int channels_ = 0;
-  std::array<std::vector<float>, 3> colours_;  // per view: valid centres x channels
   bool wrap_;
   std::uint64_t seed_;
   std::array<const float*, 3> features_{};
   std::array<int, 3> dims_pca_{};
   std::vector<Triple> coords_;
-  std::vector<std::int8_t> display_;  // per voxel: the view it shows
   double energy_ = 0.0;
 };
 

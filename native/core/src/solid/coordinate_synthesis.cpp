@@ -5,8 +5,6 @@
 #include "solid/coordinate_synthesis.hpp"
 
 #include <algorithm>
-#include <cstdio>
-#include <cstdlib>
 #include <cmath>
 #include <limits>
 #include <memory>
@@ -189,18 +187,9 @@ TextureResult synthesize_coordinates(const std::array<const Image*, 3>& view_ima
                            std::size_t(passes + 1) * solver->units() + (l == L - 1 ? solver->units() : 0));
     if (l == 0) solver->initialize(progress);
     else solver->upsample(*previous, progress);
-    auto diag = [&](const char* what) {  // DIAG (temporary)
-      if (!std::getenv("EXSYNTH_DIAG_SOLID")) return;
-      const auto f = solver->repeat_fractions();
-      std::fprintf(stderr, "level %d %-14s", l, what);
-      for (int i = 0; i < 3; ++i) std::fprintf(stderr, " view %c: %.3f %.3f %.3f |", "xyz"[i], f[i][0], f[i][1], f[i][2]);
-      std::fprintf(stderr, "\n");
-    };
-    diag(l == 0 ? "initialise" : "upsample");
     for (int it = 0; it < passes; ++it) {
       if (ctx) ctx->set_stage(stage + " correction " + std::to_string(it + 1) + "/" + std::to_string(passes));
       solver->correct(progress);
-      diag(("correction " + std::to_string(it + 1)).c_str());
       result.energy.push_back(solver->energy() * std::ldexp(1.0, 2 * exponent));
       result.energy_level.push_back(l);
     }
