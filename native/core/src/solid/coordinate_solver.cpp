@@ -167,24 +167,15 @@ float CoordinateSolver::correct_voxel(const std::array<int, 3>& p, std::vector<T
   for (std::size_t ci = 0; ci < candidates.size(); ++ci) {
     const Triple& t = candidates[ci];
     if (ci > 0 && t == current) continue;
-    // Consistency: the triple's texels must show the same lines where their
-    // slices cross (without it, three independent 2D syntheses cost nothing).
+    // The neighbourhood match first, then the consistency: the features
+    // (8 floats per texel) stay in cache, the 7-texel lines often do not,
+    // and most candidates have lost before their lines are read.
     float cost = 0.0f;
-    for (int a = 0; a < 3; ++a)
-      for (int b = a + 1; b < 3; ++b) {
-        if (!views_[a] || !views_[b]) continue;
-        const int axis = shared_axis(a, b);
-        const float* la = table_.line(a, axis, t[a]);
-        const float* lb = table_.line(b, axis, t[b]);
-        float d = 0.0f;
-        for (int c = 0; c < line_dims; ++c) d += (la[c] - lb[c]) * (la[c] - lb[c]);
-        cost += consistency_ * d;
-      }
     for (int i = 0; i < 3 && cost < best_cost; ++i) {
       if (!views_[i]) continue;
       const int d = dims_pca_[i];
       for (const Target& tg : targets[i]) {
-        if (!tg.f) continue;
+        if (!tg.f || cost >= best_cost) continue;  // costs only grow: this one has lost
         const float* f = feature(i, shift(i, t[i], tg.du, tg.dv));
         for (int c = 0; c < d; ++c) {
           const float e = f[c] - tg.f[c];
@@ -192,6 +183,18 @@ float CoordinateSolver::correct_voxel(const std::array<int, 3>& p, std::vector<T
         }
       }
     }
+    // Consistency: the triple's texels must show the same lines where their
+    // slices cross (without it, three independent 2D syntheses cost nothing).
+    for (int a = 0; a < 3; ++a)
+      for (int b = a + 1; b < 3; ++b) {
+        if (!views_[a] || !views_[b] || cost >= best_cost) continue;
+        const int axis = shared_axis(a, b);
+        const float* la = table_.line(a, axis, t[a]);
+        const float* lb = table_.line(b, axis, t[b]);
+        float d = 0.0f;
+        for (int c = 0; c < line_dims; ++c) d += (la[c] - lb[c]) * (la[c] - lb[c]);
+        cost += consistency_ * d;
+      }
     if (cost < best_cost) {
       best_cost = cost;
       best = t;
