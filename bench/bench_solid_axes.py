@@ -14,7 +14,6 @@ usage: bench_solid_axes.py --build BUILD [--size 64] [--exemplars a,b] [--option
 import argparse
 import os
 import sys
-import time
 
 import numpy as np
 
@@ -79,5 +78,4 @@ def main(argv=None):
 
 
 if __name__ == "__main__":
-    time.sleep(0)
     main()
