@@ -5,6 +5,7 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <set>
 
 #include "exsynth/errors.hpp"
@@ -105,6 +106,39 @@ TEST(SolidCoordinates, EveryVoxelIsAnExemplarTexel) {
   EXPECT_GT(used.size(), texels.size() / 4);  // not a few flat texels everywhere
   ASSERT_FALSE(r.energy.empty());
   EXPECT_LT(r.energy.back(), r.energy.front());
+}
+
+// Fraction of voxels whose value equals their +1 neighbour's along `axis`.
+double equal_neighbours(const Volume& v, int axis) {
+  std::size_t same = 0, n = 0;
+  const int c = v.channels();
+  for (int z = 0; z < v.nz(); ++z)
+    for (int y = 0; y < v.ny(); ++y)
+      for (int x = 0; x < v.nx(); ++x) {
+        std::array<int, 3> q{x, y, z};
+        if (++q[axis] >= std::array<int, 3>{v.nx(), v.ny(), v.nz()}[axis]) continue;
+        const float* a = v.data() + v.offset(x, y, z);
+        const float* b = v.data() + v.offset(q[0], q[1], q[2]);
+        same += std::equal(a, a + c, b);
+        ++n;
+      }
+  return double(same) / double(n);
+}
+
+TEST(SolidCoordinates, NoAxisIsAnExtrusion) {
+  // Every texel of a noise exemplar is distinct, so a voxel equals its
+  // neighbour only where the solid repeats a texel along that axis. The
+  // sibling-sharing upsampling gave 0.17 / 0.38 / 0.04 along x / y / z here
+  // (now 0.02 / 0.07 / 0.03).
+  const Image ex = random_image(32, 32, 3, 21);
+  SolidOptions o = coordinate_options();
+  o.size = 32;
+  o.levels = 3;
+  const Volume v = synthesize_solid(one_exemplar(ex), o).texture;
+  for (int axis = 0; axis < 3; ++axis) {
+    const double f = equal_neighbours(v, axis);
+    EXPECT_LT(f, 0.1) << "axis " << "xyz"[axis];
+  }
 }
 
 TEST(SolidCoordinates, SameSeedSameSolidWithOneTwoAndEightThreads) {

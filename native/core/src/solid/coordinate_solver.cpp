@@ -90,6 +90,19 @@ void CoordinateSolver::upsample(const CoordinateSolver& coarser, StageProgress& 
           const int a = col_axis(i), b = row_axis(i);
           child[i] = views_[i]->clamped_index(2 * c.centre_u(parent[i]) + (p[a] & 1), 2 * c.centre_v(parent[i]) + (p[b] & 1));
         }
+        // The offset moves a view's texel along its slice axes only, so the
+        // two children along view i's own axis would share its texel: every
+        // level doubled that extrusion (64^3 crackedground: 94 % of each
+        // view's texels equal to their neighbour's along its own axis, 72 %
+        // of the voxels equal to their x-neighbour; docs/solid.md). The odd
+        // child takes instead the view-i texel of the table triple of the
+        // next view's texel, which did move along that axis.
+        const Triple moved = child;
+        for (int i = 0; i < 3; ++i) {
+          if (!views_[i] || !(p[i] & 1)) continue;
+          const int j = views_[(i + 1) % 3] ? (i + 1) % 3 : (i + 2) % 3;
+          if (j != i && views_[j]) child[i] = table_.of(j, moved[j])[0][i];
+        }
       }
     }
     progress.advance((r1 - r0) * std::size_t(dims_[0]) - (r1 - r0));
@@ -154,24 +167,15 @@ float CoordinateSolver::correct_voxel(const std::array<int, 3>& p, std::vector<T
   for (std::size_t ci = 0; ci < candidates.size(); ++ci) {
     const Triple& t = candidates[ci];
     if (ci > 0 && t == current) continue;
-    // Consistency: the triple's texels must show the same lines where their
-    // slices cross (without it, three independent 2D syntheses cost nothing).
+    // The neighbourhood match first, then the consistency: the features
+    // (8 floats per texel) stay in cache, the 7-texel lines often do not,
+    // and most candidates have lost before their lines are read.
     float cost = 0.0f;
-    for (int a = 0; a < 3; ++a)
-      for (int b = a + 1; b < 3; ++b) {
-        if (!views_[a] || !views_[b]) continue;
-        const int axis = shared_axis(a, b);
-        const float* la = table_.line(a, axis, t[a]);
-        const float* lb = table_.line(b, axis, t[b]);
-        float d = 0.0f;
-        for (int c = 0; c < line_dims; ++c) d += (la[c] - lb[c]) * (la[c] - lb[c]);
-        cost += consistency_ * d;
-      }
     for (int i = 0; i < 3 && cost < best_cost; ++i) {
       if (!views_[i]) continue;
       const int d = dims_pca_[i];
       for (const Target& tg : targets[i]) {
-        if (!tg.f) continue;
+        if (!tg.f || cost >= best_cost) continue;  // costs only grow: this one has lost
         const float* f = feature(i, shift(i, t[i], tg.du, tg.dv));
         for (int c = 0; c < d; ++c) {
           const float e = f[c] - tg.f[c];
@@ -179,6 +183,18 @@ float CoordinateSolver::correct_voxel(const std::array<int, 3>& p, std::vector<T
         }
       }
     }
+    // Consistency: the triple's texels must show the same lines where their
+    // slices cross (without it, three independent 2D syntheses cost nothing).
+    for (int a = 0; a < 3; ++a)
+      for (int b = a + 1; b < 3; ++b) {
+        if (!views_[a] || !views_[b] || cost >= best_cost) continue;
+        const int axis = shared_axis(a, b);
+        const float* la = table_.line(a, axis, t[a]);
+        const float* lb = table_.line(b, axis, t[b]);
+        float d = 0.0f;
+        for (int c = 0; c < line_dims; ++c) d += (la[c] - lb[c]) * (la[c] - lb[c]);
+        cost += consistency_ * d;
+      }
     if (cost < best_cost) {
       best_cost = cost;
       best = t;

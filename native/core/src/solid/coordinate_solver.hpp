@@ -30,7 +30,9 @@ class CoordinateSolver {
   /// Coarsest level: each voxel a random table triple (seeded per voxel).
   void initialize(StageProgress& progress);
   /// Finer level: each voxel's texel in view i is 2 * (its parent's) + its
-  /// offset from the parent along that view's slice axes.
+  /// offset from the parent along that view's slice axes; the child one step
+  /// along view i's own axis takes view i's texel from the crossbar table
+  /// instead (not its sibling's, which would extrude it).
   void upsample(const CoordinateSolver& coarser, StageProgress& progress);
   /// One correction pass over every voxel (sub-passes by parity).
   void correct(StageProgress& progress);
