@@ -642,9 +642,9 @@ TEST(SurfaceSynthesis, MultiscaleIsDeterministicForAnyThreadCount) {
   EXPECT_EQ(one.texels, many.texels);
   EXPECT_EQ(one.source, many.source);
   ASSERT_EQ(one.texels.size(), 9u * 64u * 2u);
-  // Every texel is an exemplar pixel.
+  // Every texel is the exemplar pixel nearest to its (float) source.
   for (std::size_t t = 0; t < one.texel_count(); ++t) {
-    const int x = int(one.source[t * 2]), y = int(one.source[t * 2 + 1]);
+    const int x = int(std::floor(one.source[t * 2] + 0.5f)), y = int(std::floor(one.source[t * 2 + 1] + 0.5f));
     EXPECT_FLOAT_EQ(one.texels[t * 2], ex.at(x, y, 0));
   }
   EXPECT_GE(surface::multiscale_levels(ex, surface::TexelGrid(std::vector<int>(9, 8)), o), 2);
