@@ -7,9 +7,9 @@
 // level run in 3x3 waves of texels searched in parallel (deterministic
 // whatever the thread count; close to the paper's scanline order in
 // quality), and add coherent candidates (Ashikhmin / Hertzmann) to the
-// k-d tree's and, at the coarsest level, to the brute force's (two full
-// passes there after the causal one); candidates are exemplar pixels whose whole neighbourhood is
-// inside the exemplar; Wei & Levoy's pass with the coarse
+// k-d tree's and, at the coarsest level, to the brute force's;
+// candidates are exemplar pixels whose whole neighbourhood is inside the
+// exemplar; Wei & Levoy's pass with the coarse
 // neighbourhood alone is replaced by coordinate upsampling (Lefebvre &
 // Hoppe 2005); the random pick among near-best matches is off by default
 // (knn_tolerance 0); sources are float exemplar coordinates shifted by the
@@ -58,8 +58,8 @@ using Source = Eigen::Vector2f;
 
 /// Texels of one face map go in kWaveModulus^2 waves (see waves()).
 constexpr int kWaveModulus = 3;
-/// Full brute-force passes at the coarsest level after the causal one.
-constexpr int kCoarsestFullPasses = 2;
+/// Full brute-force passes at the coarsest level after the causal one (see run()).
+constexpr int kCoarsestFullPasses = 1;
 /// Coherent candidates re-ranked by their exact distance (see search_texel).
 constexpr std::size_t kCoherentExact = 4;
 /// nanoflann's approximation: matches within (1 + eps) of the true nearest in
@@ -112,7 +112,11 @@ class MultiscaleSolver {
       StageProgress progress(ctx_, "multiscale level " + std::to_string(top) + " exemplar", 0.0, 1.0, 1);
       const std::unique_ptr<PassIndex> ix = pass_index(top, lay, false, progress);
       run_brute_pass(top, lay, *ix, true, 100);
-      // Two full passes after the causal one: 0.331 vs 0.341 with one (3: 0.326).
+      // Full passes after the causal one: with whole-pixel sources 0.341 /
+      // 0.331 / 0.326 for 1 / 2 / 3 (flat plane, 10 seeds); with float
+      // sources 0.353 / 0.348 for 1 / 2 (20 seeds), but the second took
+      // +23 % CPU on the cow at 73 k texels with a 128^2 exemplar (52 k
+      // coarsest texels, one a ptex face, against 256 pixels).
       for (int k = 0; k < kCoarsestFullPasses; ++k) run_brute_pass(top, lay, *ix, false, 101 + std::uint64_t(k));
     }
     for (int l = top - 1; l >= 0; --l) {
