@@ -430,6 +430,7 @@ class MultiscaleSolver {
     std::vector<float> d2;
     std::vector<std::pair<float, int>> best;
     std::vector<std::pair<int, Source>> cands;
+    std::vector<char> mark;
     std::vector<std::pair<float, int>> coh;
     Scratch(int D, int d, int k) : q(D), qp(d), idx(std::size_t(k)), d2(std::size_t(k)) {}
   };
@@ -446,9 +447,11 @@ class MultiscaleSolver {
   /// The coherent candidates of texel t at level l: the source of each
   /// fine-neighbourhood sample's texel (visited ones only, if given) shifted
   /// back by that texel's offset, one per pixel (the first), candidates of
-  /// the pass only.
+  /// the pass only. mark: per-thread flags by pixel (all clear on return).
   void coherent_candidates(int l, std::size_t t, const Layout& lay, const PassIndex& ix,
-                           const std::vector<char>* visited, std::vector<std::pair<int, Source>>& out) const {
+                           const std::vector<char>* visited, std::vector<std::pair<int, Source>>& out,
+                           std::vector<char>& mark) const {
+    mark.resize(ix.row.size(), 0);
     const int side = 2 * lay.fine_r + 1, per = side * side;
     const std::int32_t* nb = fine_nb_.data() + t * std::size_t(per);
     const std::vector<Source>& src = src_[std::size_t(l)];
@@ -465,9 +468,11 @@ class MultiscaleSolver {
       // mesh's boundary faces, where samples past the boundary repeat the
       // last texel (visible stripes the window score hardly sees).
       if (pixel < 0 || ix.row[std::size_t(pixel)] < 0) continue;
-      if (std::find_if(out.begin(), out.end(), [&](const auto& o) { return o.first == pixel; }) != out.end()) continue;
+      if (mark[std::size_t(pixel)]) continue;
+      mark[std::size_t(pixel)] = 1;
       out.emplace_back(pixel, c);
     }
+    for (const std::pair<int, Source>& o : out) mark[std::size_t(o.first)] = 0;
   }
 
   /// One texel of a k-d tree pass: the approximate nearest neighbours,
@@ -498,7 +503,7 @@ class MultiscaleSolver {
     const Source app = source_of(pick(s.best, t, stream), ex_[std::size_t(l)].width());
     if (!lay.fine || !(opt_.coherence > 0)) return app;
 
-    coherent_candidates(l, t, lay, ix, nullptr, s.cands);
+    coherent_candidates(l, t, lay, ix, nullptr, s.cands, s.mark);
     s.coh.clear();
     for (std::size_t i = 0; i < s.cands.size(); ++i) s.coh.push_back({pca_d2(ix, s, s.cands[i].first), int(i)});
     if (s.coh.empty()) return app;
@@ -560,6 +565,7 @@ class MultiscaleSolver {
   struct BruteScratch {
     std::vector<std::pair<float, int>> dist, best;
     std::vector<std::pair<int, Source>> cands;
+    std::vector<char> mark;
   };
 
   /// Brute force at the coarsest level: the pixel for texel t from the
@@ -575,7 +581,7 @@ class MultiscaleSolver {
     float coh_d2 = std::numeric_limits<float>::infinity();
     const Source* coh = nullptr;
     if (opt_.coherence > 0) {
-      coherent_candidates(l, t, lay, ix, visited, s.cands);
+      coherent_candidates(l, t, lay, ix, visited, s.cands, s.mark);
       for (const std::pair<int, Source>& c : s.cands) {
         const float d = d2[std::size_t(ix.row[std::size_t(c.first)])];
         if (d < coh_d2) coh_d2 = d, coh = &c.second;
