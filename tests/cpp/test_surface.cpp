@@ -15,6 +15,7 @@
 
 #include "exsynth/errors.hpp"
 #include "exsynth/surface.hpp"
+#include "support/cancel.hpp"
 #include "support/textures.hpp"
 #include "support/threads.hpp"
 #include "surface/charts.hpp"
@@ -665,6 +666,31 @@ TEST(SurfaceSynthesis, CancelStopsTheJob) {
   ctx.cancel();
   SurfaceSynthesisOptions o = small_options(SurfaceMethod::Coherent);
   EXPECT_THROW(synthesize_surface(s, exsynth::testing::disc_texture(16, 16, 3, 1), o, &ctx), Cancelled);
+}
+
+TEST(SurfaceSynthesis, CancelInEveryStage) {
+  // Every stage of both methods (the multiscale levels' frames, landing
+  // tables, exemplar indices, coarsest brute force and tree passes) sees a
+  // cancel made inside it.
+  const PolygonMesh m = flat_grid(2);
+  const SubdivSurface s(m);
+  const Image ex = exsynth::testing::disc_texture(32, 32, 3, 5);
+  for (SurfaceMethod method : {SurfaceMethod::Coherent, SurfaceMethod::Multiscale}) {
+    SurfaceSynthesisOptions o = small_options(method);
+    o.field = constant_field(m.vertices.size(), V3(1, 0, 0));
+    const auto job = [&](ExecContext* ctx) { synthesize_surface(s, ex, o, ctx); };
+    const auto log = exsynth::testing::stages_of(job);
+    ASSERT_GE(log.names.size(), 3u);
+    if (method == SurfaceMethod::Multiscale) {
+      EXPECT_THAT(log.names, ::testing::Contains(::testing::HasSubstr("coarsest")));
+      EXPECT_THAT(log.names, ::testing::Contains(::testing::HasSubstr("level 0 frames")));
+    }
+    for (const std::string& stage : log.names) {
+      const auto outcome = exsynth::testing::cancel_in_stage(job, stage);
+      EXPECT_TRUE(outcome.threw_cancelled) << stage;
+      EXPECT_EQ(outcome.stage_at_throw, stage);
+    }
+  }
 }
 
 // ---- atlas and limit mesh ---------------------------------------------------------
