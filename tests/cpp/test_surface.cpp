@@ -15,6 +15,7 @@
 
 #include "exsynth/errors.hpp"
 #include "exsynth/surface.hpp"
+#include "support/cancel.hpp"
 #include "support/textures.hpp"
 #include "support/threads.hpp"
 #include "surface/charts.hpp"
@@ -642,9 +643,9 @@ TEST(SurfaceSynthesis, MultiscaleIsDeterministicForAnyThreadCount) {
   EXPECT_EQ(one.texels, many.texels);
   EXPECT_EQ(one.source, many.source);
   ASSERT_EQ(one.texels.size(), 9u * 64u * 2u);
-  // Every texel is an exemplar pixel.
+  // Every texel is the exemplar pixel nearest to its (float) source.
   for (std::size_t t = 0; t < one.texel_count(); ++t) {
-    const int x = int(one.source[t * 2]), y = int(one.source[t * 2 + 1]);
+    const int x = int(std::floor(one.source[t * 2] + 0.5f)), y = int(std::floor(one.source[t * 2 + 1] + 0.5f));
     EXPECT_FLOAT_EQ(one.texels[t * 2], ex.at(x, y, 0));
   }
   EXPECT_GE(surface::multiscale_levels(ex, surface::TexelGrid(std::vector<int>(9, 8)), o), 2);
@@ -665,6 +666,31 @@ TEST(SurfaceSynthesis, CancelStopsTheJob) {
   ctx.cancel();
   SurfaceSynthesisOptions o = small_options(SurfaceMethod::Coherent);
   EXPECT_THROW(synthesize_surface(s, exsynth::testing::disc_texture(16, 16, 3, 1), o, &ctx), Cancelled);
+}
+
+TEST(SurfaceSynthesis, CancelInEveryStage) {
+  // Every stage of both methods (the multiscale levels' frames, landing
+  // tables, exemplar indices, coarsest brute force and tree passes) sees a
+  // cancel made inside it.
+  const PolygonMesh m = flat_grid(2);
+  const SubdivSurface s(m);
+  const Image ex = exsynth::testing::disc_texture(32, 32, 3, 5);
+  for (SurfaceMethod method : {SurfaceMethod::Coherent, SurfaceMethod::Multiscale}) {
+    SurfaceSynthesisOptions o = small_options(method);
+    o.field = constant_field(m.vertices.size(), V3(1, 0, 0));
+    const auto job = [&](ExecContext* ctx) { synthesize_surface(s, ex, o, ctx); };
+    const auto log = exsynth::testing::stages_of(job);
+    ASSERT_GE(log.names.size(), 3u);
+    if (method == SurfaceMethod::Multiscale) {
+      EXPECT_THAT(log.names, ::testing::Contains(::testing::HasSubstr("coarsest")));
+      EXPECT_THAT(log.names, ::testing::Contains(::testing::HasSubstr("level 0 frames")));
+    }
+    for (const std::string& stage : log.names) {
+      const auto outcome = exsynth::testing::cancel_in_stage(job, stage);
+      EXPECT_TRUE(outcome.threw_cancelled) << stage;
+      EXPECT_EQ(outcome.stage_at_throw, stage);
+    }
+  }
 }
 
 // ---- atlas and limit mesh ---------------------------------------------------------

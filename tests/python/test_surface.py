@@ -179,15 +179,20 @@ def test_multiscale_on_a_flat_plane_scores_near_the_2d_synthesis_and_coherence_h
     got = {c: np.mean([nn_distance(assemble(_native.texture_surface(
         v, fs, fv, ex8, field=field, face_resolution=r, seed=seed, method="multiscale", coherence=c), n, r), ex)
         for seed in (4, 5, 6, 7, 8)]) for c in (0.0, 1.0)}
-    ref = nn_distance(_native.synthesize_image(ex8, width=n * r, height=n * r, seed=4)["image"], ex)
-    # Measured (mean of seeds 4-8, 80 windows): 0.387 with coherence (the
-    # default), 0.408 without (Wei-Levoy's search alone); the 2D synthesis
-    # 0.31 (seed 4): 1.25x. Before the finer levels started from the coarser
-    # level's sources upsampled: 0.451 (1.46x). (One seed alone is too noisy
-    # to show the coherence gap.) The absolute bound keeps the test about the
-    # surface method when the 2D synthesis changes.
-    assert got[1.0] < 0.42, f"multiscale {got[1.0]:.3f}"
-    assert got[1.0] < 1.5 * ref, f"multiscale {got[1.0]:.3f} vs 2D {ref:.3f}"
+    # The 2D reference is the texture optimisation by name (the default 2D
+    # method changed to coordinate synthesis, 0.43 at seed 4 in this measure).
+    ref = nn_distance(_native.synthesize_image(ex8, width=n * r, height=n * r, seed=4,
+                                               method="optimization")["image"], ex)
+    # Measured (mean of seeds 4-8, 80 windows): 0.365 with coherence (the
+    # default), 0.446 without (Wei-Levoy's search alone); the 2D optimisation
+    # 0.309 at seed 4 (0.353 over seeds 4-8, 0.341 over 4-23): 1.18x the
+    # seed-4 figure, 1.03x the same seeds'. Before the coarsest level took
+    # coherent candidates: 0.387 (1.25x); before the finer levels started
+    # from the coarser level's sources upsampled: 0.451 (1.46x). (One seed
+    # alone is too noisy to show the coherence gap.) The absolute bound
+    # keeps the test about the surface method when the 2D synthesis changes.
+    assert got[1.0] < 0.38, f"multiscale {got[1.0]:.3f}"
+    assert got[1.0] < 1.25 * ref, f"multiscale {got[1.0]:.3f} vs 2D {ref:.3f}"
     assert got[1.0] < 0.98 * got[0.0], f"with coherence {got[1.0]:.3f} vs without {got[0.0]:.3f}"
 
 
@@ -304,7 +309,8 @@ def triangulated_grid(n):
     return v, np.full(len(faces), 3, np.int32), np.array(faces, np.int32).ravel()
 
 
-def test_patches_on_a_triangulated_plane_copy_the_exemplar_exactly():
+@pytest.mark.parametrize("method", ["coherent", "multiscale"])
+def test_patches_on_a_triangulated_plane_copy_the_exemplar_exactly(method):
     # Coherent synthesis copies patches: neighbouring texels of one patch
     # have sources that differ by exactly their offset on the surface (the
     # kites' square texel grids are sheared, so the offsets are fractional).
@@ -316,7 +322,7 @@ def test_patches_on_a_triangulated_plane_copy_the_exemplar_exactly():
     v, fs, fv = triangulated_grid(n)
     ex = exemplar()
     field = np.tile([1.0, 0.0, 0.0], (len(v), 1))
-    res = _native.texture_surface(v, fs, fv, ex, field=field, texels_per_unit=12, seed=4)
+    res = _native.texture_surface(v, fs, fv, ex, field=field, texels_per_unit=12, seed=4, method=method)
     r, off = res["face_resolution"], res["face_offset"]
     faces = np.repeat(np.arange(len(r)), r * r)
     k = np.arange(len(faces)) - off[faces]
@@ -329,5 +335,33 @@ def test_patches_on_a_triangulated_plane_copy_the_exemplar_exactly():
     i, j = np.nonzero(np.triu(d2 < (1.5 * h) ** 2, 1))
     mismatch = np.linalg.norm(drift[i] - drift[j], axis=1)
     same = mismatch < 1.0
-    assert same.mean() > 0.85, same.mean()  # measured 0.93: large patches
-    assert np.percentile(mismatch[same], 90) < 0.05, np.percentile(mismatch[same], 90)
+    if method == "coherent":
+        assert same.mean() > 0.85, same.mean()  # measured 0.93: large patches
+        assert np.percentile(mismatch[same], 90) < 0.05, np.percentile(mismatch[same], 90)
+    else:
+        # Multiscale: float sources and chord offsets as the coherent method
+        # (whole-pixel sources: median 0.45 px); its patches are smaller
+        # (measured: 0.66 of the pairs in one patch, 90th percentile 0.68 px).
+        assert same.mean() > 0.5, same.mean()
+        assert np.median(mismatch[same]) < 0.02, np.median(mismatch[same])
+
+
+def test_multiscale_seeds_give_different_textures(flat):
+    # The coarsest level's causal pass followed from its first texel's random
+    # pixel alone: seeds 8 / 17, 9 / 18, 10 / 19 and 11 / 16 gave the same
+    # texture on the 4 x 4 plane (and 8 / 17 shared half its texels before
+    # the coarsest level took coherent candidates). Now the texels of the
+    # first row keep random pixels there: no pair of seeds 4-23 shares more
+    # than a fifth of its texels (measured: none shares 20 %). Still open:
+    # with a 32^2 exemplar at 8 texels a face seeds 9 / 19 share 99.5 %.
+    n, r, ex, _ = flat
+    v, fs, fv = grid(n)
+    field = np.tile([1.0, 0.0, 0.0], (len(v), 1))
+    ex8 = (ex * 255).astype(np.uint8)
+    seeds = (8, 9, 10, 11, 16, 17, 18, 19)
+    runs = [_native.texture_surface(v, fs, fv, ex8, field=field, face_resolution=r, seed=s, method="multiscale")["texels"]
+            for s in seeds]
+    for i in range(len(runs)):
+        for j in range(i + 1, len(runs)):
+            shared = (np.abs(runs[i] - runs[j]).max(1) < 1e-6).mean()
+            assert shared < 0.2, (seeds[i], seeds[j], shared)

@@ -7,11 +7,14 @@
 // level run in 3x3 waves of texels searched in parallel (deterministic
 // whatever the thread count; close to the paper's scanline order in
 // quality), and add coherent candidates (Ashikhmin / Hertzmann) to the
-// k-d tree's; candidates are exemplar pixels whose whole neighbourhood is
-// inside the exemplar; Wei & Levoy's pass with the coarse
+// k-d tree's and, at the coarsest level, to the brute force's;
+// candidates are exemplar pixels whose whole neighbourhood is inside the
+// exemplar; Wei & Levoy's pass with the coarse
 // neighbourhood alone is replaced by coordinate upsampling (Lefebvre &
 // Hoppe 2005); the random pick among near-best matches is off by default
-// (knn_tolerance 0).
+// (knn_tolerance 0); sources are float exemplar coordinates shifted by the
+// chords between texel centres, as the coherent method's (sheared texel
+// grids, as on triangles' sub-faces, keep their sub-pixel offsets).
 #include <algorithm>
 #include <atomic>
 #include <cmath>
@@ -48,9 +51,15 @@ int multiscale_levels(const Image& ex, const TexelGrid&, const SurfaceSynthesisO
 namespace {
 
 using search::RowMatrixXf;
+/// A texel's source: float exemplar coordinates (pixel centres at integers).
+/// Texels read the nearest pixel; the fraction carries a patch's sub-pixel
+/// offsets across texels, as in the coherent method.
+using Source = Eigen::Vector2f;
 
 /// Texels of one face map go in kWaveModulus^2 waves (see waves()).
 constexpr int kWaveModulus = 3;
+/// Full brute-force passes at the coarsest level after the causal one (see run()).
+constexpr int kCoarsestFullPasses = 1;
 /// Coherent candidates re-ranked by their exact distance (see search_texel).
 constexpr std::size_t kCoherentExact = 4;
 /// nanoflann's approximation: matches within (1 + eps) of the true nearest in
@@ -103,7 +112,12 @@ class MultiscaleSolver {
       StageProgress progress(ctx_, "multiscale level " + std::to_string(top) + " exemplar", 0.0, 1.0, 1);
       const std::unique_ptr<PassIndex> ix = pass_index(top, lay, false, progress);
       run_brute_pass(top, lay, *ix, true, 100);
-      run_brute_pass(top, lay, *ix, false, 101);
+      // Full passes after the causal one: with whole-pixel sources 0.341 /
+      // 0.331 / 0.326 for 1 / 2 / 3 (flat plane, 10 seeds); with float
+      // sources 0.353 / 0.348 for 1 / 2 (20 seeds), but the second took
+      // +23 % CPU on the cow at 73 k texels with a 128^2 exemplar (52 k
+      // coarsest texels, one a ptex face, against 256 pixels).
+      for (int k = 0; k < kCoarsestFullPasses; ++k) run_brute_pass(top, lay, *ix, false, 101 + std::uint64_t(k));
     }
     for (int l = top - 1; l >= 0; --l) {
       prepare_level(l);
@@ -124,10 +138,9 @@ class MultiscaleSolver {
     out.texels = values_[0];
     const std::size_t n = grids_[0].size();
     out.source.resize(n * 2);
-    const int w = ex_[0].width();
     for (std::size_t t = 0; t < n; ++t) {
-      out.source[t * 2] = float(src_[0][t] % w);
-      out.source[t * 2 + 1] = float(src_[0][t] / w);
+      out.source[t * 2] = src_[0][t].x();
+      out.source[t * 2 + 1] = src_[0][t].y();
     }
   }
 
@@ -150,32 +163,60 @@ class MultiscaleSolver {
 
   double spacing(int level) const { return h_ * double(1 << level); }
 
-  void set_texel(int l, std::size_t t, int pixel) {
-    src_[std::size_t(l)][t] = pixel;
+  /// The pixel (y W + x) nearest to source c at level l; wraps c into the
+  /// exemplar when tileable, else -1 when it reads outside.
+  int pixel_of(int l, Source& c) const {
+    const Image& e = ex_[std::size_t(l)];
+    const int W = e.width(), H = e.height();
+    if (opt_.tileable_exemplar) {
+      c.x() -= float(W) * std::floor((c.x() + 0.5f) / float(W));
+      c.y() -= float(H) * std::floor((c.y() + 0.5f) / float(H));
+    }
+    const int x = std::clamp(int(std::floor(c.x() + 0.5f)), -1, W), y = std::clamp(int(std::floor(c.y() + 0.5f)), -1, H);
+    return x < 0 || y < 0 || x >= W || y >= H ? -1 : y * W + x;
+  }
+
+  static Source source_of(int pixel, int W) { return Source(float(pixel % W), float(pixel / W)); }
+
+  void set_texel(int l, std::size_t t, Source c) {
+    const int pixel = pixel_of(l, c);
+    src_[std::size_t(l)][t] = c;
     const Image& e = ex_[std::size_t(l)];
     const float* p = e.data() + std::size_t(pixel) * std::size_t(C_);
     std::copy(p, p + C_, values_[std::size_t(l)].begin() + std::ptrdiff_t(t * std::size_t(C_)));
   }
 
+  /// Offset of texel q from texel t at level l in exemplar pixels: the chord
+  /// between their centres in t's frame (as the coherent method's offsets),
+  /// or the sample's (dl, dm) where the two are more than a pixel apart (a
+  /// sample stopped at a boundary, a tight bend).
+  Eigen::Vector2f offset(int l, std::size_t t, std::size_t q, int dl, int dm) const {
+    const Eigen::Vector3f c = lpos_[q] - lpos_[t];
+    const float h = float(spacing(l));
+    const Eigen::Vector2f o(c.dot(lt1_[t]) / h, -c.dot(lt2_[t]) / h);
+    const Eigen::Vector2f lm = Eigen::Vector2f(float(dl), float(dm));
+    return (o - lm).squaredNorm() > 1.0f ? lm : o;
+  }
+
   void init_random(int l) {
     const std::size_t n = grids_[std::size_t(l)].size();
     values_[std::size_t(l)].assign(n * std::size_t(C_), 0.0f);
-    src_[std::size_t(l)].assign(n, 0);
+    src_[std::size_t(l)].assign(n, Source::Zero());
     const Image& e = ex_[std::size_t(l)];
     for (std::size_t t = 0; t < n; ++t) {
       IndexRng rng(opt_.seed, t, 1000 + std::uint64_t(l));
-      set_texel(l, t, int(rng.below(std::uint64_t(e.width()) * std::uint64_t(e.height()))));
+      set_texel(l, t, source_of(int(rng.below(std::uint64_t(e.width()) * std::uint64_t(e.height()))), e.width()));
     }
   }
 
-  /// Level l from level l + 1's sources: texel t copies the fine pixel at
-  /// its offset from the coarser texel its centre falls in (coordinate
-  /// upsampling, Lefebvre & Hoppe 2005).
+  /// Level l from level l + 1's sources: texel t takes the fine coordinate
+  /// at its offset from the coarser texel its centre falls in (coordinate
+  /// upsampling, Lefebvre & Hoppe 2005; coarse pixel X covers fine pixels
+  /// 2X and 2X + 1, centred at 2X + 0.5).
   void upsample_level(int l) {
     const TexelGrid& g = grids_[std::size_t(l)];
     const TexelGrid& gc = grids_[std::size_t(l + 1)];
     const int W = ex_[std::size_t(l)].width(), H = ex_[std::size_t(l)].height();
-    const int Wc = ex_[std::size_t(l + 1)].width();
     const double hf = spacing(l);
     for (std::size_t t = 0; t < g.size(); ++t) {
       const SurfacePoint p = g.centre(t);
@@ -184,23 +225,20 @@ class MultiscaleSolver {
       const std::size_t f0 = frames_.grid.texel(p);
       const Eigen::Vector3f chord = (frames_.approx(p).position - frames_.approx(pc).position).cast<float>();
       const double ox = chord.dot(frames_.t1[f0]) / hf, oy = -chord.dot(frames_.t2[f0]) / hf;
-      const int sp = src_[std::size_t(l + 1)][tc];
-      int x = int(std::floor(2.0 * (sp % Wc) + 1.0 + ox)), y = int(std::floor(2.0 * (sp / Wc) + 1.0 + oy));
-      if (opt_.tileable_exemplar) {
-        x = ((x % W) + W) % W;
-        y = ((y % H) + H) % H;
-      } else {
-        x = std::clamp(x, 0, W - 1);
-        y = std::clamp(y, 0, H - 1);
+      const Source& sc = src_[std::size_t(l + 1)][tc];
+      Source c(float(2.0 * sc.x() + 0.5 + ox), float(2.0 * sc.y() + 0.5 + oy));
+      if (!opt_.tileable_exemplar) {
+        c.x() = std::clamp(c.x(), 0.0f, float(W - 1));
+        c.y() = std::clamp(c.y(), 0.0f, float(H - 1));
       }
-      set_texel(l, t, y * W + x);
+      set_texel(l, t, c);
     }
   }
 
   void init_level(int l) {
     const std::size_t n = grids_[std::size_t(l)].size();
     values_[std::size_t(l)].assign(n * std::size_t(C_), 0.0f);
-    src_[std::size_t(l)].assign(n, 0);
+    src_[std::size_t(l)].assign(n, Source::Zero());
   }
 
   void exemplar_feature(int l, int x, int y, const Layout& lay, float* out) const {
@@ -233,6 +271,11 @@ class MultiscaleSolver {
     }
   }
 
+  /// A landing-table entry of a sample that stopped at a boundary (it reads
+  /// the texel where it stopped, but gives no coherent candidate), and back.
+  static std::int32_t past_boundary(std::int32_t q) { return -1 - q; }
+  static std::size_t landed(std::int32_t e) { return std::size_t(e < 0 ? -1 - e : e); }
+
   /// The texels of level `lv` the (2r+1)^2 samples at spacing hh around each
   /// texel of level l land in: walked once per level (in parallel) and read
   /// by every pass (the walks are most of the work on fine meshes, where
@@ -254,7 +297,10 @@ class MultiscaleSolver {
         bool valid[kMaxSamples];
         neighbourhood_points(surface_, frames_, charts_, p, t0, hh, r, pts, valid, &stats);
         std::int32_t* row = tab.data() + t * std::size_t(per);
-        for (int k = 0; k < per; ++k) row[k] = std::int32_t(to.texel(pts[k]));
+        for (int k = 0; k < per; ++k) {
+          const std::int32_t q = std::int32_t(to.texel(pts[k]));
+          row[k] = valid[k] ? q : past_boundary(q);
+        }
       }
       in_chart += stats.in_chart;
       walked += stats.walked;
@@ -269,7 +315,7 @@ class MultiscaleSolver {
     const std::vector<float>& vals = values_[std::size_t(lv)];
     const int per = (2 * r + 1) * (2 * r + 1);
     for (int k = 0; k < per; ++k) {
-      const std::size_t tq = std::size_t(landing[k]);
+      const std::size_t tq = landed(landing[k]);
       const float* v = vals.data() + tq * std::size_t(C_);
       const bool known = !visited || (*visited)[tq];
       for (int c = 0; c < C_; ++c) o[c] = known ? v[c] * w[std::size_t(k)] : std::numeric_limits<float>::quiet_NaN();
@@ -286,9 +332,29 @@ class MultiscaleSolver {
     if (lay.coarse) gather(coarse_nb_.data() + t * std::size_t(nc), l + 1, lay.coarse_r, lay.coarse_w, o);
   }
 
+  /// Positions and frames at the texel centres of level l (from the finest
+  /// level's cache), for the offsets between texels.
+  void level_frames(int l) {
+    const TexelGrid& g = grids_[std::size_t(l)];
+    lpos_.resize(g.size());
+    lt1_.resize(g.size());
+    lt2_.resize(g.size());
+    StageProgress progress(ctx_, "multiscale level " + std::to_string(l) + " frames", 0.0, 1.0, g.size());
+    parallel_chunks(g.size(), 4096, progress, [&](std::size_t b, std::size_t e) {
+      for (std::size_t t = b; t < e; ++t) {
+        const SurfacePoint p = g.centre(t);
+        const std::size_t f0 = frames_.grid.texel(p);
+        lpos_[t] = frames_.approx(p).position.cast<float>();
+        lt1_[t] = frames_.t1[f0];
+        lt2_[t] = frames_.t2[f0];
+      }
+    });
+  }
+
   /// Walks the neighbourhoods of level l (current and coarser) once.
   void prepare_level(int l) {
     const int fr = opt_.fine_neighborhood / 2, cr = opt_.coarse_neighborhood / 2;
+    level_frames(l);
     fine_nb_ = landing_table(l, l, fr, spacing(l));
     coarse_nb_ = l + 1 < levels_ ? landing_table(l, l + 1, cr, spacing(l + 1)) : std::vector<std::int32_t>{};
   }
@@ -363,7 +429,8 @@ class MultiscaleSolver {
     std::vector<std::size_t> idx;
     std::vector<float> d2;
     std::vector<std::pair<float, int>> best;
-    std::vector<int> seen;
+    std::vector<std::pair<int, Source>> cands;
+    std::vector<char> mark;
     std::vector<std::pair<float, int>> coh;
     Scratch(int D, int d, int k) : q(D), qp(d), idx(std::size_t(k)), d2(std::size_t(k)) {}
   };
@@ -377,6 +444,37 @@ class MultiscaleSolver {
     return (ix.X.row(ix.row[std::size_t(pixel)]) - s.q).squaredNorm();
   }
 
+  /// The coherent candidates of texel t at level l: the source of each
+  /// fine-neighbourhood sample's texel (visited ones only, if given) shifted
+  /// back by that texel's offset, one per pixel (the first), candidates of
+  /// the pass only. mark: per-thread flags by pixel (all clear on return).
+  void coherent_candidates(int l, std::size_t t, const Layout& lay, const PassIndex& ix,
+                           const std::vector<char>* visited, std::vector<std::pair<int, Source>>& out,
+                           std::vector<char>& mark) const {
+    mark.resize(ix.row.size(), 0);
+    const int side = 2 * lay.fine_r + 1, per = side * side;
+    const std::int32_t* nb = fine_nb_.data() + t * std::size_t(per);
+    const std::vector<Source>& src = src_[std::size_t(l)];
+    out.clear();
+    for (int j = 0; j < per; ++j) {
+      if (nb[j] < 0) continue;  // past a boundary
+      const std::size_t q = std::size_t(nb[j]);
+      if (visited && !(*visited)[q]) continue;
+      Source c = src[q] - offset(l, t, q, j % side - lay.fine_r, j / side - lay.fine_r);
+      const int pixel = pixel_of(l, c);
+      // Border pixels are no candidates here either: compared over the part
+      // of their neighbourhood inside the exemplar they scored the flat
+      // plane better (0.383 vs 0.397, 10 seeds) but copied columns down the
+      // mesh's boundary faces, where samples past the boundary repeat the
+      // last texel (visible stripes the window score hardly sees).
+      if (pixel < 0 || ix.row[std::size_t(pixel)] < 0) continue;
+      if (mark[std::size_t(pixel)]) continue;
+      mark[std::size_t(pixel)] = 1;
+      out.emplace_back(pixel, c);
+    }
+    for (const std::pair<int, Source>& o : out) mark[std::size_t(o.first)] = 0;
+  }
+
   /// One texel of a k-d tree pass: the approximate nearest neighbours,
   /// re-ranked by their exact distance, one picked at random within the
   /// tolerance; with the current level in the neighbourhood, the coherent
@@ -386,15 +484,42 @@ class MultiscaleSolver {
   /// more than (1 + coherence) closer (squared L2). Flat-plane window
   /// distance (5 seeds): 0.61 without coherence, 0.49 with it; ranking the
   /// coherent candidates by PCA distance alone gave 0.525, exact distances
-  /// for all of them cost 13x more per candidate for 0.490.
-  int search_texel(int l, std::size_t t, const Layout& lay, const PassIndex& ix, Scratch& s,
-                   std::uint64_t stream) const {
+  /// for all of them cost 13x more per candidate for 0.490. The bounded
+  /// tree search gave the same sources as the unbounded one on the flat and
+  /// triangulated planes (2 seeds each) for 13 % less CPU on the flat plane.
+  Source search_texel(int l, std::size_t t, const Layout& lay, const PassIndex& ix, Scratch& s,
+                      std::uint64_t stream) const {
     target_feature(l, t, lay, s.q.data());
     s.qp.noalias() = (s.q - ix.pca.mean) * ix.pca.basis;
+    // The coherent candidates first: the best of them (exact distance) bounds
+    // the tree search, which can only change the pick by a match more than
+    // (1 + coherence) closer — and the PCA distance (the tree's metric) is
+    // never more than the exact one, so the tree need not look farther.
+    float coh_d2 = std::numeric_limits<float>::infinity();
+    const Source* coh = nullptr;
+    if (lay.fine && opt_.coherence > 0) {
+      coherent_candidates(l, t, lay, ix, nullptr, s.cands, s.mark);
+      s.coh.clear();
+      for (std::size_t i = 0; i < s.cands.size(); ++i) s.coh.push_back({pca_d2(ix, s, s.cands[i].first), int(i)});
+      const std::size_t m = std::min(s.coh.size(), kCoherentExact);
+      std::partial_sort(s.coh.begin(), s.coh.begin() + std::ptrdiff_t(m), s.coh.end());
+      for (std::size_t i = 0; i < m; ++i) {
+        const std::pair<int, Source>& c = s.cands[std::size_t(s.coh[i].second)];
+        const float d2 = exact_d2(ix, s, c.first);
+        if (d2 < coh_d2) {
+          coh_d2 = d2;
+          coh = &c.second;
+        }
+      }
+    }
     const std::size_t k = s.idx.size();
     nanoflann::KNNResultSet<float, std::size_t> result(k);
     result.init(s.idx.data(), s.d2.data());
+    // (nanoflann keeps its k-th distance in the last slot: a bound there
+    // prunes the search until k matches inside it are found.)
+    if (coh) s.d2[k - 1] = coh_d2 / float(1.0 + opt_.coherence);
     ix.tree->index->findNeighbors(result, s.qp.data(), nanoflann::SearchParams(32, kSearchEps));
+    if (result.size() == 0) return *coh;  // nothing (1 + coherence) closer
     s.best.clear();
     for (std::size_t i = 0; i < result.size(); ++i) {
       const int p = ix.pixel[s.idx[i]];
@@ -402,48 +527,8 @@ class MultiscaleSolver {
     }
     std::sort(s.best.begin(), s.best.end());
     const float app_d2 = s.best[0].first;
-    const int app = pick(s.best, t, stream);
-    if (!lay.fine || !(opt_.coherence > 0)) return app;
-
-    const Image& e = ex_[std::size_t(l)];
-    const int W = e.width(), H = e.height(), side = 2 * lay.fine_r + 1, per = side * side;
-    const std::int32_t* nb = fine_nb_.data() + t * std::size_t(per);
-    const std::vector<int>& src = src_[std::size_t(l)];
-    s.seen.clear();
-    s.coh.clear();
-    for (int j = 0; j < per; ++j) {
-      const int sp = src[std::size_t(nb[j])];
-      int x = sp % W - (j % side - lay.fine_r), y = sp / W - (j / side - lay.fine_r);
-      if (opt_.tileable_exemplar) {
-        x = ((x % W) + W) % W;
-        y = ((y % H) + H) % H;
-      } else if (x < 0 || y < 0 || x >= W || y >= H) {
-        continue;
-      }
-      const int c = y * W + x;
-      // Border pixels are no candidates here either: compared over the part
-      // of their neighbourhood inside the exemplar they scored the flat
-      // plane better (0.383 vs 0.397, 10 seeds) but copied columns down the
-      // mesh's boundary faces, where samples past the boundary repeat the
-      // last texel (visible stripes the window score hardly sees).
-      if (ix.row[std::size_t(c)] < 0) continue;
-      if (std::find(s.seen.begin(), s.seen.end(), c) != s.seen.end()) continue;
-      s.seen.push_back(c);
-      s.coh.push_back({pca_d2(ix, s, c), c});
-    }
-    if (s.coh.empty()) return app;
-    const std::size_t m = std::min(s.coh.size(), kCoherentExact);
-    std::partial_sort(s.coh.begin(), s.coh.begin() + std::ptrdiff_t(m), s.coh.end());
-    float coh_d2 = std::numeric_limits<float>::infinity();
-    int coh = -1;
-    for (std::size_t i = 0; i < m; ++i) {
-      const float d2 = exact_d2(ix, s, s.coh[i].second);
-      if (d2 < coh_d2) {
-        coh_d2 = d2;
-        coh = s.coh[i].second;
-      }
-    }
-    return coh_d2 <= app_d2 * float(1.0 + opt_.coherence) ? coh : app;
+    const Source app = source_of(pick(s.best, t, stream), ex_[std::size_t(l)].width());
+    return coh && coh_d2 <= app_d2 * float(1.0 + opt_.coherence) ? *coh : app;
   }
 
   /// Texels of level l in waves: texel (i, j) of its face map in wave
@@ -466,7 +551,7 @@ class MultiscaleSolver {
     return w;
   }
 
-  void commit(int l, const std::vector<std::size_t>& texels, const std::vector<int>& pixels) {
+  void commit(int l, const std::vector<std::size_t>& texels, const std::vector<Source>& pixels) {
     for (std::size_t i = 0; i < texels.size(); ++i) set_texel(l, texels[i], pixels[i]);
   }
 
@@ -476,13 +561,48 @@ class MultiscaleSolver {
     const int k = std::min(opt_.knn, int(ix.X.rows()));
     StageProgress progress(ctx_, stage, 0.0, 1.0, n);
     for (const std::vector<std::size_t>& texels : waves(l)) {
-      std::vector<int> pixels(texels.size());
+      std::vector<Source> pixels(texels.size());
       parallel_chunks(texels.size(), 256, progress, [&](std::size_t b, std::size_t e) {
         Scratch s(int(ix.X.cols()), ix.pca.dims(), k);
         for (std::size_t i = b; i < e; ++i) pixels[i] = search_texel(l, texels[i], lay, ix, s, stream);
       });
       commit(l, texels, pixels);
     }
+  }
+
+  /// Per-thread buffers of the brute-force passes.
+  struct BruteScratch {
+    std::vector<std::pair<float, int>> dist, best;
+    std::vector<std::pair<int, Source>> cands;
+    std::vector<char> mark;
+  };
+
+  /// Brute force at the coarsest level: the pixel for texel t from the
+  /// distances d2 of its neighbourhood to every candidate row (d2 is
+  /// reordered). The best coherent candidate (see coherent_candidates) wins
+  /// unless the best of all is more than (1 + coherence) closer, as in the
+  /// k-d tree passes: the coarsest level decides the patches every finer
+  /// level copies, and the exact nearest alone broke them up (flat-plane
+  /// window distance 0.413 without, 0.341 with it, 10 seeds, 400 windows).
+  Source brute_pick(int l, std::size_t t, const Layout& lay, const PassIndex& ix, std::vector<float>& d2,
+                    const std::vector<char>* visited, BruteScratch& s, std::uint64_t stream) const {
+    const int P = int(d2.size()), k = std::min(opt_.knn, P);
+    float coh_d2 = std::numeric_limits<float>::infinity();
+    const Source* coh = nullptr;
+    if (opt_.coherence > 0) {
+      coherent_candidates(l, t, lay, ix, visited, s.cands, s.mark);
+      for (const std::pair<int, Source>& c : s.cands) {
+        const float d = d2[std::size_t(ix.row[std::size_t(c.first)])];
+        if (d < coh_d2) coh_d2 = d, coh = &c.second;
+      }
+    }
+    s.dist.resize(std::size_t(P));
+    for (int p = 0; p < P; ++p) s.dist[std::size_t(p)] = {d2[std::size_t(p)], ix.pixel[std::size_t(p)]};
+    std::partial_sort(s.dist.begin(), s.dist.begin() + k, s.dist.end());
+    s.best.assign(s.dist.begin(), s.dist.begin() + k);
+    const float best_d2 = s.best[0].first;
+    const Source app = source_of(pick(s.best, t, stream), ex_[std::size_t(l)].width());
+    return coh && coh_d2 <= best_d2 * float(1.0 + opt_.coherence) ? *coh : app;
   }
 
   /// The coarsest level by brute force over all exemplar pixels, in place.
@@ -493,32 +613,35 @@ class MultiscaleSolver {
   void run_brute_pass(int l, const Layout& lay, const PassIndex& ix, bool causal, std::uint64_t stream) {
     const std::size_t n = grids_[std::size_t(l)].size();
     const int P = int(ix.X.rows()), D = int(ix.X.cols());
-    const int k = std::min(opt_.knn, P);
     StageProgress progress(ctx_, std::string("multiscale level ") + std::to_string(l) + " coarsest", 0.0, 1.0, n);
     if (causal) {
       std::vector<char> visited(n, 0);
       Eigen::RowVectorXf q(D), mask(D);
-      std::vector<std::pair<float, int>> dist(static_cast<std::size_t>(P)), best;
+      std::vector<float> d2(static_cast<std::size_t>(P));
+      BruteScratch s;
       const std::vector<std::size_t> order = synthesis_order(surface_, grids_[std::size_t(l)]);
       for (std::size_t i = 0; i < n; ++i) {
         if ((i & 255) == 0) progress.check();
         const std::size_t t = order[i];
         target_feature(l, t, lay, q.data(), &visited);
-        bool any = false;
+        int known_dims = 0;
         for (int d = 0; d < D; ++d) {
           const bool known = !std::isnan(q[d]);
-          any = any || known;
+          known_dims += known ? 1 : 0;
           mask[d] = known ? 1.0f : 0.0f;
           if (!known) q[d] = 0.0f;
         }
-        if (any) {
+        // Texels that see fewer than a ninth of their samples synthesized
+        // (the first row of the first face) keep their random pixels: with
+        // the first texel alone random, the whole level followed from one
+        // of 576 pixels and seeds 8 / 17, 9 / 18, 10 / 19, 11 / 16 gave the
+        // same texture (flat plane, seeds 4-23).
+        if (known_dims * 9 >= D) {
           tbb::parallel_for(tbb::blocked_range<int>(0, P, 64), [&](const tbb::blocked_range<int>& r) {
             for (int p = r.begin(); p < r.end(); ++p)
-              dist[std::size_t(p)] = {((ix.X.row(p) - q).cwiseProduct(mask)).squaredNorm(), ix.pixel[std::size_t(p)]};
+              d2[std::size_t(p)] = ((ix.X.row(p) - q).cwiseProduct(mask)).squaredNorm();
           }, tbb::simple_partitioner());
-          std::partial_sort(dist.begin(), dist.begin() + k, dist.end());
-          best.assign(dist.begin(), dist.begin() + k);
-          set_texel(l, t, pick(best, t, stream));
+          set_texel(l, t, brute_pick(l, t, lay, ix, d2, &visited, s, stream));
         }
         visited[t] = 1;
       }
@@ -526,16 +649,15 @@ class MultiscaleSolver {
       return;
     }
     for (const std::vector<std::size_t>& texels : waves(l)) {
-      std::vector<int> pixels(texels.size());
+      std::vector<Source> pixels(texels.size());
       parallel_chunks(texels.size(), 16, progress, [&](std::size_t b, std::size_t e) {
         Eigen::RowVectorXf q(D);
-        std::vector<std::pair<float, int>> dist(static_cast<std::size_t>(P)), best;
+        std::vector<float> d2(static_cast<std::size_t>(P));
+        BruteScratch s;
         for (std::size_t i = b; i < e; ++i) {
           target_feature(l, texels[i], lay, q.data());
-          for (int p = 0; p < P; ++p) dist[std::size_t(p)] = {(ix.X.row(p) - q).squaredNorm(), ix.pixel[std::size_t(p)]};
-          std::partial_sort(dist.begin(), dist.begin() + k, dist.end());
-          best.assign(dist.begin(), dist.begin() + k);
-          pixels[i] = pick(best, texels[i], stream);
+          for (int p = 0; p < P; ++p) d2[std::size_t(p)] = (ix.X.row(p) - q).squaredNorm();
+          pixels[i] = brute_pick(l, texels[i], lay, ix, d2, nullptr, s, stream);
         }
       });
       commit(l, texels, pixels);
@@ -553,7 +675,8 @@ class MultiscaleSolver {
   std::vector<Image> ex_;
   std::vector<TexelGrid> grids_;
   std::vector<std::vector<float>> values_;
-  std::vector<std::vector<int>> src_;
+  std::vector<std::vector<Source>> src_;
+  std::vector<Eigen::Vector3f> lpos_, lt1_, lt2_;  // texel centres and frames of the level being synthesized
   std::vector<std::int32_t> fine_nb_, coarse_nb_;  // landing tables of the level being synthesized
   ChartStats stats_;  // over all landing tables
 
