@@ -206,6 +206,17 @@ struct CoordinateSynthesisOptions {
   /// Exhaustive correction (every exemplar position is a candidate): the
   /// reference the tests compare the k-coherence search with.
   bool exhaustive = false;
+  /// Refinement after the finest level (refine_passes rounds, 0 = none):
+  /// each output refine_patch^2 patch (every refine_stride pixels) finds its
+  /// nearest exemplar patch in colour (PatchMatch: the coordinates it holds,
+  /// its neighbours' matches, refine_random random probes at halving radii),
+  /// then each pixel takes the coordinate, among those its patches' matches
+  /// propose, nearest in colour to all of them (every pixel stays an
+  /// exemplar pixel). Seams judged at the measure's 8 x 8 scale (docs/solid.md).
+  int refine_passes = 0;
+  int refine_patch = 8;
+  int refine_stride = 2;
+  int refine_random = 4;
 };
 
 struct ImageSynthesisOptions : TextureOptimizationOptions {
