@@ -28,14 +28,21 @@ def classes(E, out, quality, stride=2, copy_eps=1.0, min_cells=16):
     offset = (sy - oy) * 100003 + (sx - ox)
     exact = rms * E.contrast < copy_eps
     copied = np.zeros_like(exact)
+    best = 0
     for t in np.unique(offset[exact]):
         lab, n = quality.label4(exact & (offset == t))
         sizes = np.bincount(lab.ravel())[1:]
         for c in np.nonzero(sizes >= min_cells)[0] + 1:
-            copied |= lab == c
+            cells = lab == c
+            copied |= cells
+            foot = np.zeros(out.shape[:2], bool)
+            for i, j in np.argwhere(cells):
+                foot[i * stride:i * stride + E.k, j * stride:j * stride + E.k] = True
+            best = max(best, int(foot.sum()))
     seam = ~exact
     e = rms[seam]
-    return dict(nn_rel=float(rms.mean()), copied=float(copied.mean()), exact_small=float((exact & ~copied).mean()),
+    return dict(nn_rel=float(rms.mean()), copied=float(copied.mean()),
+                max_copy=best / float(E.img.shape[0] * E.img.shape[1]), exact_small=float((exact & ~copied).mean()),
                 seam=float(seam.mean()), seam_err=float(e.mean()) if e.size else 0.0,
                 seam_p50=float(np.median(e)) if e.size else 0.0, seam_p90=float(np.percentile(e, 90)) if e.size else 0.0)
 
@@ -53,7 +60,7 @@ def main():
     from PIL import Image
     opts = eval(f"dict({a.options})", {})  # noqa: S307 - a developer's command line
     tmp = tempfile.mkdtemp()
-    keys = ("nn_rel", "copied", "exact_small", "seam", "seam_err", "seam_p50", "seam_p90")
+    keys = ("nn_rel", "copied", "max_copy", "exact_small", "seam", "seam_err", "seam_p50", "seam_p90")
     print(f"{'':28}" + " ".join(f"{k:>11}" for k in keys), f"  options: {a.options or 'defaults'}; load {os.getloadavg()[0]:.1f}")
     tot = {}
     for name in a.exemplars.split(","):
@@ -79,6 +86,7 @@ def main():
             Image.fromarray(np.concatenate(row, 1)).save(os.path.join(a.png, name + ".png"))
     for label, ms in tot.items():
         print(f"{'mean ' + label:28}" + " ".join(f"{np.mean([m[k] for m in ms]):11.3f}" for k in keys))
+        print(f"{'worst ' + label:28}" + " ".join(f"{(min if k in ('exact_small',) else max)(m[k] for m in ms):11.3f}" for k in keys))
 
 
 if __name__ == "__main__":

@@ -91,11 +91,22 @@ def test_methods_and_sizes():
 def test_exhaustive_search_runs_on_a_tiny_input():
     # The C++ tests compare it with the candidate search pixel by pixel; here the binding path.
     ex = exemplar("crackedground.png", size=16)
-    res = _native.synthesize_image(ex, width=12, height=12, seed=2, coarsest_spacing=2, exhaustive=True)
-    assert res["image"].shape == (12, 12, 3) and len(res["energy"]) == 2 * 2  # 2 levels x 2 corrections
+    res = _native.synthesize_image(ex, width=12, height=12, seed=2, coarsest_spacing=2, exhaustive=True,
+                                   refine_passes=1, refine_patch=6)
+    assert res["image"].shape == (12, 12, 3)
+    assert len(res["energy"]) == 2 * 2 + 1  # 2 levels x 2 corrections, 1 refinement round
 
 
 def test_over_the_memory_budget_is_refused_before_allocating():
     ex = exemplar("crackedground.png", size=64)
     with pytest.raises(_native.OverBudgetError, match="image synthesis of 4000x4000 .*raise the memory budget"):
         _native.synthesize_image(ex, width=4000, height=4000, memory_budget=1 << 20)
+
+
+def test_patch_refinement_options_are_checked_in_the_core():
+    ex = exemplar("crackedground.png", size=32)
+    off = _native.synthesize_image(ex, width=24, height=24, seed=3, refine_passes=0)
+    on = _native.synthesize_image(ex, width=24, height=24, seed=3, refine_passes=2)
+    assert len(on["energy"]) == len(off["energy"]) + 2 and not np.array_equal(on["image"], off["image"])
+    with pytest.raises(_native.InvalidInputError, match=r"refine_stride must be between 1 and refine_patch \(4\)"):
+        _native.synthesize_image(ex, width=8, height=8, refine_patch=4, refine_stride=5)

@@ -109,12 +109,14 @@ std::vector<Coord> PatchRefiner::match_candidates(const CoordImage& s, const std
   return out;
 }
 
-double PatchRefiner::match(const CoordImage& s, std::vector<Coord>& nn, int round, StageProgress& progress) const {
+double PatchRefiner::match(const CoordImage& s, std::vector<Coord>& nn, int round, StageProgress& progress,
+                           std::vector<float>* dist) const {
   const int n = patch(s);
   const std::vector<int> xs = corners(s.width, n), ys = corners(s.height, n);
   const Image out = gather(s, n);
   const std::vector<Coord> prev = nn;  // the round's matches read only the last round's
   nn.assign(xs.size() * ys.size(), lo_);
+  if (dist) dist->assign(nn.size(), 0.0f);
   std::vector<double> row_sum(ys.size(), 0.0);
   parallel_chunks(ys.size(), 2, progress, [&](std::size_t begin, std::size_t end) {
     for (std::size_t gy = begin; gy < end; ++gy) {
@@ -133,6 +135,7 @@ double PatchRefiner::match(const CoordImage& s, std::vector<Coord>& nn, int roun
           }
         }
         nn[gy * xs.size() + gx] = best;
+        if (dist) (*dist)[gy * xs.size() + gx] = best_d;
         sum += best_d;
       }
       row_sum[gy] = sum;
@@ -159,34 +162,45 @@ void PatchRefiner::vote(CoordImage& s, const std::vector<Coord>& nn, StageProgre
   const auto cx = covering(xs, s.width), cy = covering(ys, s.height);
   const CoordImage prev = s;
   parallel_chunks(std::size_t(s.height), 4, progress, [&](std::size_t begin, std::size_t end) {
-    std::vector<Coord> props;
-    std::vector<float> mean(static_cast<std::size_t>(C), 0.0f);
+    std::vector<Coord> props;  // distinct proposals ...
+    std::vector<int> count;    // ... and how many patches made each
     for (std::size_t y = begin; y < end; ++y)
       for (int x = 0; x < s.width; ++x) {
         props.clear();
-        std::fill(mean.begin(), mean.end(), 0.0f);
+        count.clear();
         for (auto [gy, oy] : cy[y])
           for (auto [gx, ox] : cx[std::size_t(x)]) {
-            const Coord e = nn[std::size_t(gy) * xs.size() + std::size_t(gx)];
+            const std::size_t g = std::size_t(gy) * xs.size() + std::size_t(gx);
+            const Coord e = nn[g];
             const Coord c{e.u + ox, e.v + oy};
-            const float* col = colours_.data() + colours_.offset(c.u, c.v);
-            for (int k = 0; k < C; ++k) mean[std::size_t(k)] += col[k];
-            props.push_back(c);
+            const auto at = std::find(props.begin(), props.end(), c);
+            if (at == props.end()) props.push_back(c), count.push_back(1);
+            else ++count[std::size_t(at - props.begin())];
           }
         if (props.empty()) continue;
-        for (float& m : mean) m /= float(props.size());
-        // Sum over proposals of |colour(c) - colour(proposal)|^2 = |colour(c) - mean|^2 * count + const.
-        Coord best = prev.at(x, int(y));
+        // The medoid of the proposals (sum of unsquared colour distances):
+        // the nearest to their mean (sum of squares) favoured mid-tones, a
+        // regression to the mean (sharpness 0.80-0.84 at 64^2 exemplars).
+        // Each patch counts once: weighting by its match (Wexler et al.
+        // 2007, exp(-d / (tau median d)), tau 0.3 and 1) raised copy_rate
+        // from 0.29 to 0.42 on slate, marble1, brick and drkwood2 for 0.005
+        // of nn_rel (mean-colour vote, 8 x 8, 4 rounds).
         auto cost = [&](Coord c) {
           const float* col = colours_.data() + colours_.offset(c.u, c.v);
           float d = 0.0f;
-          for (int k = 0; k < C; ++k) d += (col[k] - mean[std::size_t(k)]) * (col[k] - mean[std::size_t(k)]);
+          for (std::size_t i = 0; i < props.size(); ++i) {
+            const float* q = colours_.data() + colours_.offset(props[i].u, props[i].v);
+            float e = 0.0f;
+            for (int k = 0; k < C; ++k) e += (col[k] - q[k]) * (col[k] - q[k]);
+            d += float(count[i]) * std::sqrt(e);
+          }
           return d;
         };
+        Coord best = prev.at(x, int(y));
         float best_d = cost(best);
-        for (const Coord& c : props) {
-          const float d = cost(c);
-          if (d < best_d) best_d = d, best = c;
+        for (std::size_t i = 0; i < props.size(); ++i) {
+          const float d = cost(props[i]);
+          if (d < best_d) best_d = d, best = props[i];
         }
         s.at(x, int(y)) = best;
       }

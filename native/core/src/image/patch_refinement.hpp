@@ -47,7 +47,8 @@ class PatchRefiner {
   /// One match step: `nn` (one per patch, row-major over corners; empty on
   /// the first round) becomes each patch's best candidate; returns the mean
   /// squared distance per patch pixel.
-  double match(const CoordImage& s, std::vector<Coord>& nn, int round, StageProgress& progress) const;
+  double match(const CoordImage& s, std::vector<Coord>& nn, int round, StageProgress& progress,
+               std::vector<float>* dist = nullptr) const;
   /// One vote step from the matches.
   void vote(CoordImage& s, const std::vector<Coord>& nn, StageProgress& progress) const;
   /// Candidates of patch (gx, gy) in the match step, in the order scored
