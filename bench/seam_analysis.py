@@ -41,7 +41,7 @@ def classes(E, out, quality, stride=2, copy_eps=1.0, min_cells=16):
             best = max(best, int(foot.sum()))
     seam = ~exact
     e = rms[seam]
-    return dict(nn_rel=float(rms.mean()), copied=float(copied.mean()),
+    return dict(nn_rel=float(rms.mean()), sharp=quality.grad_energy(out) / max(E.grad, 1e-9), copied=float(copied.mean()),
                 max_copy=best / float(E.img.shape[0] * E.img.shape[1]), exact_small=float((exact & ~copied).mean()),
                 seam=float(seam.mean()), seam_err=float(e.mean()) if e.size else 0.0,
                 seam_p50=float(np.median(e)) if e.size else 0.0, seam_p90=float(np.percentile(e, 90)) if e.size else 0.0)
@@ -60,7 +60,7 @@ def main():
     from PIL import Image
     opts = eval(f"dict({a.options})", {})  # noqa: S307 - a developer's command line
     tmp = tempfile.mkdtemp()
-    keys = ("nn_rel", "copied", "max_copy", "exact_small", "seam", "seam_err", "seam_p50", "seam_p90")
+    keys = ("nn_rel", "sharp", "copied", "max_copy", "exact_small", "seam", "seam_err", "seam_p50", "seam_p90")
     print(f"{'':28}" + " ".join(f"{k:>11}" for k in keys), f"  options: {a.options or 'defaults'}; load {os.getloadavg()[0]:.1f}")
     tot = {}
     for name in a.exemplars.split(","):
@@ -86,7 +86,7 @@ def main():
             Image.fromarray(np.concatenate(row, 1)).save(os.path.join(a.png, name + ".png"))
     for label, ms in tot.items():
         print(f"{'mean ' + label:28}" + " ".join(f"{np.mean([m[k] for m in ms]):11.3f}" for k in keys))
-        print(f"{'worst ' + label:28}" + " ".join(f"{(min if k in ('exact_small',) else max)(m[k] for m in ms):11.3f}" for k in keys))
+        print(f"{'worst ' + label:28}" + " ".join(f"{(min if k in ('exact_small', 'sharp') else max)(m[k] for m in ms):11.3f}" for k in keys))
 
 
 if __name__ == "__main__":

@@ -225,7 +225,7 @@ Returns {'solid': (Z, Y, X, C) float32, 'energy': [...], 'energy_level': [...]}.
       "2D texture synthesis: exemplar -> (height, width, C) float32 image (tileable=True to tile).\n"
       "method='coordinates' (default; Lefebvre & Hoppe 2005 in appearance space: jitter=0.25, jitter_from=8,\n"
       "corrections=2, candidates_k=1, coherence=1, wide_below=0, appearance_window=5, appearance_dims=8,\n"
-      "coarsest_spacing=0 (auto), exhaustive=False, refine_passes=2, refine_patch=12, refine_stride=2, refine_random=1;\n"
+      "coarsest_spacing=0 (auto), exhaustive=False, refine_passes=0, refine_patch=12, refine_stride=2, refine_random=1;\n"
       "also tileable, max_exemplar_size, seed) or 'optimization' (the optimiser of\n"
       "synthesize_solid, same options). Returns {'image': ..., 'energy': [...]}.");
 }

@@ -160,6 +160,7 @@ TEST(ImageCoordinates, SameSeedSameImageOnOneAndEightThreads) {
   for (bool tileable : {false, true}) {
     ImageSynthesisOptions o = small_image();
     o.tileable = tileable;
+    o.coordinates.refine_passes = 2;  // the patch refinement too (off by default)
     const Image one = exsynth::testing::on_threads(1, [&] { return synthesize_image(ex, o); });
     const Image eight = exsynth::testing::on_threads(8, [&] { return synthesize_image(ex, o); });
     EXPECT_EQ(one.values(), eight.values());
@@ -202,6 +203,7 @@ TEST(ImageCoordinates, TinyAndHugeValuedExemplarsWork) {
 TEST(ImageCoordinates, CancelInEveryStage) {
   const Image ex = disc_texture(32, 32, 3, 38);
   ImageSynthesisOptions o = small_image();
+  o.coordinates.refine_passes = 2;  // off by default
   const auto job = [&](ExecContext* ctx) { synthesize_image(ex, o, ctx); };
   const auto log = exsynth::testing::stages_of(job);
   ASSERT_GE(log.names.size(), 4u);
@@ -211,7 +213,7 @@ TEST(ImageCoordinates, CancelInEveryStage) {
     EXPECT_TRUE(outcome.threw_cancelled) << stage;
     EXPECT_EQ(outcome.stage_at_throw, stage);
   }
-  EXPECT_THAT(log.names.back(), HasSubstr("patch refinement"));  // on by default
+  EXPECT_THAT(log.names.back(), HasSubstr("patch refinement"));
   EXPECT_THAT(log.names[log.names.size() - 2], HasSubstr("(coordinates)"));
 }
 

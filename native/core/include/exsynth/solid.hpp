@@ -211,12 +211,12 @@ struct CoordinateSynthesisOptions {
   /// (corners refine_stride apart) finds its nearest exemplar patch in colour
   /// (PatchMatch: the coordinates it holds, its neighbours' matches,
   /// refine_random random probes per halving radius), then each pixel takes
-  /// the coordinate, among those its patches' matches propose, nearest in
-  /// colour to all of them (every pixel stays an exemplar pixel). Defaults:
-  /// the lowest mean nn_rel on the 8 exemplars with copy_rate <= 0.35 on
-  /// each (12 x 12, 2 rounds; 16 x 16 or 3 rounds copy more of slate;
-  /// docs/solid.md has the sweep).
-  int refine_passes = 2;
+  /// the coordinate, among those its patches' matches propose, that is the
+  /// medoid in colour of all of them (every pixel stays an exemplar pixel).
+  /// Off by default: on the 8 exemplars every setting tried lowered nn_rel
+  /// but pushed copy_rate past 0.35 on some exemplar (12 x 12, 1 round:
+  /// nn_rel 0.266, copy_rate 0.34, worst 0.38; docs/solid.md has the sweep).
+  int refine_passes = 0;
   int refine_patch = 12;
   int refine_stride = 2;
   int refine_random = 1;
