@@ -370,44 +370,47 @@ TEST(ImagePatchRefinement, MatchTakesTheBestOfItsCandidates) {
   }
 }
 
-TEST(ImagePatchRefinement, VoteTakesTheMedoidOfTheProposals) {
+TEST(ImagePatchRefinement, VoteTakesTheMedoidOrTheNearestToTheMean) {
   const Image ex = disc_texture(24, 24, 2, 44);
-  const CoordinateSynthesisOptions o = refining(4, 2);
-  const CoordinateSolver s(ex, o, false, 5, nullptr, 0, 1);
-  const PatchRefiner r(ex, s.lowest(), s.highest(), o, false, 5);
-  const CoordImage before = s.initial(9, 8);
-  StageProgress progress(nullptr, "", 0, 1, 1);
-  std::vector<Coord> nn;
-  r.match(before, nn, 0, progress);
-  CoordImage after = before;
-  r.vote(after, nn, progress);
-  const std::vector<int> xs = r.corners(9, 4), ys = r.corners(8, 4);
-  for (int y = 0; y < 8; ++y)
-    for (int x = 0; x < 9; ++x) {
-      // Proposals: each covering patch's match moved to the pixel.
-      std::vector<Coord> props;
-      for (std::size_t gy = 0; gy < ys.size(); ++gy)
-        for (std::size_t gx = 0; gx < xs.size(); ++gx)
-          if (x >= xs[gx] && x < xs[gx] + 4 && y >= ys[gy] && y < ys[gy] + 4) {
-            const Coord e = nn[gy * xs.size() + gx];
-            props.push_back({e.u + x - xs[gx], e.v + y - ys[gy]});
+  for (bool medoid : {true, false}) {
+    CoordinateSynthesisOptions o = refining(4, 2);
+    o.refine_medoid = medoid;
+    const CoordinateSolver s(ex, o, false, 5, nullptr, 0, 1);
+    const PatchRefiner r(ex, s.lowest(), s.highest(), o, false, 5);
+    const CoordImage before = s.initial(9, 8);
+    StageProgress progress(nullptr, "", 0, 1, 1);
+    std::vector<Coord> nn;
+    r.match(before, nn, 0, progress);
+    CoordImage after = before;
+    r.vote(after, nn, progress);
+    const std::vector<int> xs = r.corners(9, 4), ys = r.corners(8, 4);
+    for (int y = 0; y < 8; ++y)
+      for (int x = 0; x < 9; ++x) {
+        // Proposals: each covering patch's match moved to the pixel.
+        std::vector<Coord> props;
+        for (std::size_t gy = 0; gy < ys.size(); ++gy)
+          for (std::size_t gx = 0; gx < xs.size(); ++gx)
+            if (x >= xs[gx] && x < xs[gx] + 4 && y >= ys[gy] && y < ys[gy] + 4) {
+              const Coord e = nn[gy * xs.size() + gx];
+              props.push_back({e.u + x - xs[gx], e.v + y - ys[gy]});
+            }
+        ASSERT_FALSE(props.empty());
+        auto cost = [&](Coord c) {  // sum of colour distances (squared: !medoid) to the proposals, one per patch
+          double t = 0.0;
+          for (Coord p : props) {
+            double e = 0.0;
+            for (int k = 0; k < 2; ++k) e += std::pow(double(ex.at(c.u, c.v, k)) - double(ex.at(p.u, p.v, k)), 2);
+            t += medoid ? std::sqrt(e) : e;  // the mean minimises the sum of squares
           }
-      ASSERT_FALSE(props.empty());
-      auto cost = [&](Coord c) {  // sum of colour distances to the proposals (one per patch)
-        double t = 0.0;
-        for (Coord p : props) {
-          double e = 0.0;
-          for (int k = 0; k < 2; ++k) e += std::pow(double(ex.at(c.u, c.v, k)) - double(ex.at(p.u, p.v, k)), 2);
-          t += std::sqrt(e);
-        }
-        return t;
-      };
-      double best = cost(before.at(x, y));
-      for (Coord p : props) best = std::min(best, cost(p));
-      const Coord got = after.at(x, y);
-      EXPECT_TRUE(got == before.at(x, y) || std::find(props.begin(), props.end(), got) != props.end());
-      EXPECT_NEAR(cost(got), best, 1e-4 * (1 + best));
-    }
+          return t;
+        };
+        double best = cost(before.at(x, y));
+        for (Coord p : props) best = std::min(best, cost(p));
+        const Coord got = after.at(x, y);
+        EXPECT_TRUE(got == before.at(x, y) || std::find(props.begin(), props.end(), got) != props.end());
+        EXPECT_NEAR(cost(got), best, 1e-4 * (1 + best));
+      }
+  }
 }
 
 TEST(ImagePatchRefinement, LowersThePatchEnergy) {

@@ -220,6 +220,10 @@ struct CoordinateSynthesisOptions {
   int refine_patch = 12;
   int refine_stride = 2;
   int refine_random = 1;
+  /// The vote: the medoid of the proposals (true) or the proposal nearest
+  /// their mean colour (false: less copying, lower nn_rel, but it favours
+  /// mid-tones: lower sharpness; docs/solid.md).
+  bool refine_medoid = true;
 };
 
 struct ImageSynthesisOptions : TextureOptimizationOptions {

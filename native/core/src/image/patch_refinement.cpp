@@ -185,6 +185,7 @@ void PatchRefiner::vote(CoordImage& s, const std::vector<Coord>& nn, StageProgre
         // 2007, exp(-d / (tau median d)), tau 0.3 and 1) raised copy_rate
         // from 0.29 to 0.42 on slate, marble1, brick and drkwood2 for 0.005
         // of nn_rel (mean-colour vote, 8 x 8, 4 rounds).
+        // With refine_medoid false: the squared distances, i.e. the nearest to the mean.
         auto cost = [&](Coord c) {
           const float* col = colours_.data() + colours_.offset(c.u, c.v);
           float d = 0.0f;
@@ -192,7 +193,7 @@ void PatchRefiner::vote(CoordImage& s, const std::vector<Coord>& nn, StageProgre
             const float* q = colours_.data() + colours_.offset(props[i].u, props[i].v);
             float e = 0.0f;
             for (int k = 0; k < C; ++k) e += (col[k] - q[k]) * (col[k] - q[k]);
-            d += float(count[i]) * std::sqrt(e);
+            d += float(count[i]) * (opt_.refine_medoid ? std::sqrt(e) : e);
           }
           return d;
         };
