@@ -224,9 +224,9 @@ Returns {'solid': (Z, Y, X, C) float32, 'energy': [...], 'energy_level': [...]}.
       py::arg("exemplar"), py::kw_only(), py::arg("width") = 128, py::arg("height") = 128,
       py::arg("ctx") = py::none(),
       "2D texture synthesis: exemplar -> (height, width, C) float32 image (tileable=True to tile).\n"
-      "method='coordinates' (default; Lefebvre & Hoppe 2005 in appearance space: jitter=0.25, jitter_from=8,\n"
+      "method='coordinates' (default; Lefebvre & Hoppe 2005 in appearance space: jitter=0.5, jitter_from=8,\n"
       "corrections=2, candidates_k=1, coherence=1, wide_below=0, appearance_window=5, appearance_dims=8,\n"
-      "coarsest_spacing=0 (auto), exhaustive=False, refine_passes=0, refine_patch=12, refine_stride=2, refine_random=1, refine_medoid=True;\n"
+      "coarsest_spacing=0 (auto), exhaustive=False, refine_passes=1, refine_patch=12, refine_stride=4, refine_random=1, refine_medoid=True;\n"
       "also tileable, max_exemplar_size, seed) or 'optimization' (the optimiser of\n"
       "synthesize_solid, same options). Returns {'image': ..., 'energy': [...]}.");
 }
