@@ -155,14 +155,16 @@ TEST(ImageCoordinates, UpsamplingContinuesTheParentPatch) {
     }
 }
 
-TEST(ImageCoordinates, SameSeedSameImageOnOneAndEightThreads) {
+TEST(ImageCoordinates, SameSeedSameImageOnOneTwoAndEightThreads) {
   const Image ex = disc_texture(32, 32, 3, 35);
   for (bool tileable : {false, true}) {
     ImageSynthesisOptions o = small_image();
     o.tileable = tileable;
     o.coordinates.refine_passes = 2;  // the patch refinement too (off by default)
     const Image one = exsynth::testing::on_threads(1, [&] { return synthesize_image(ex, o); });
+    const Image two = exsynth::testing::on_threads(2, [&] { return synthesize_image(ex, o); });
     const Image eight = exsynth::testing::on_threads(8, [&] { return synthesize_image(ex, o); });
+    EXPECT_EQ(one.values(), two.values());
     EXPECT_EQ(one.values(), eight.values());
     o.seed = 4;
     EXPECT_NE(synthesize_image(ex, o).values(), one.values());

@@ -473,11 +473,13 @@ Image synthesize_coordinates(const Image& exemplar, const ImageSynthesisOptions&
   {
     // Peak: the index's windows (n^2 C floats per pixel) and coefficients,
     // the appearance stack (8 floats per pixel per level, ~log2(edge)
-    // levels), and per output pixel two coordinate images and the colours.
+    // levels), and per output pixel two coordinate images and the colours
+    // (the patch refinement: one more coordinate image and gathered colours).
     const double n = opt.coordinates.appearance_window, px = double(ex->pixel_count());
     const double levels = std::log2(std::max(2, std::min(ex->width(), ex->height()))) + 1;
     const double bytes = 4.0 * px * (n * n * ex->channels() + 8.0 * (levels + 2)) +
-                         double(opt.width) * opt.height * (16.0 + 4.0 * ex->channels());
+                         double(opt.width) * opt.height * (16.0 + 4.0 * ex->channels()) *
+                             (opt.coordinates.refine_passes > 0 ? 2.0 : 1.0);
     check_memory_budget(bytes, opt.memory_budget,
                         "image synthesis of " + std::to_string(opt.width) + "x" + std::to_string(opt.height) +
                             " from a " + std::to_string(ex->width()) + "x" + std::to_string(ex->height()) +
