@@ -105,6 +105,11 @@ py::kwargs set_image_options(ImageSynthesisOptions& o, const py::kwargs& kw) {
     else if (k == "appearance_dims") c.appearance_dims = int_arg(v, k, 1, 64);
     else if (k == "coarsest_spacing") c.coarsest_spacing = int_arg(v, k, 0, 1024, "pixels (a power of two, 0 = auto)");
     else if (k == "exhaustive") c.exhaustive = bool_arg(v, k);
+    else if (k == "refine_passes") c.refine_passes = int_arg(v, k, 0, 16, "(0 = no patch refinement)");
+    else if (k == "refine_patch") c.refine_patch = int_arg(v, k, 2, 32, "pixels");
+    else if (k == "refine_stride") c.refine_stride = int_arg(v, k, 1, 32, "pixels (at most refine_patch)");
+    else if (k == "refine_random") c.refine_random = int_arg(v, k, 0, 16, "probes per radius");
+    else if (k == "refine_medoid") c.refine_medoid = bool_arg(v, k);
     else rest[item.first] = item.second;
   }
   return rest;
@@ -207,7 +212,7 @@ Returns {'solid': (Z, Y, X, C) float32, 'energy': [...], 'energy_level': [...]}.
         opt.height = int_arg(height, "height", 1, 16384, "pixels");
         set_common(opt, set_image_options(opt, kw),
                    "method, jitter, jitter_from, corrections, candidates_k, coherence, wide_below, "
-                   "appearance_window, appearance_dims, coarsest_spacing, exhaustive, tileable, max_exemplar_size, memory_budget, "
+                   "appearance_window, appearance_dims, coarsest_spacing, exhaustive, refine_passes, refine_patch, refine_stride, refine_random, refine_medoid, tileable, max_exemplar_size, memory_budget, "
                    "seed; with method='optimization' also synthesize_solid's (levels, neighborhood, iterations, ...)");
         Image img;
         std::vector<double> energy;
@@ -224,9 +229,10 @@ Returns {'solid': (Z, Y, X, C) float32, 'energy': [...], 'energy_level': [...]}.
       py::arg("exemplar"), py::kw_only(), py::arg("width") = 128, py::arg("height") = 128,
       py::arg("ctx") = py::none(),
       "2D texture synthesis: exemplar -> (height, width, C) float32 image (tileable=True to tile).\n"
-      "method='coordinates' (default; Lefebvre & Hoppe 2005 in appearance space: jitter=0.25, jitter_from=8,\n"
+      "method='coordinates' (default; Lefebvre & Hoppe 2005 in appearance space: jitter=0.5, jitter_from=8,\n"
       "corrections=2, candidates_k=1, coherence=1, wide_below=0, appearance_window=5, appearance_dims=8,\n"
-      "coarsest_spacing=0 (auto), exhaustive=False; also tileable, max_exemplar_size, seed) or 'optimization' (the optimiser of\n"
+      "coarsest_spacing=0 (auto), exhaustive=False, refine_passes=1, refine_patch=12, refine_stride=4, refine_random=1, refine_medoid=True;\n"
+      "also tileable, max_exemplar_size, seed) or 'optimization' (the optimiser of\n"
       "synthesize_solid, same options). Returns {'image': ..., 'energy': [...]}.");
 }
 

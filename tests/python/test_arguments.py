@@ -77,7 +77,9 @@ FUNCTIONS = {
         "method": "str", "jitter": ("real", 0, 4), "jitter_from": ("int", 1, 1024), "corrections": ("int", 0, 16),
         "candidates_k": ("int", 1, 16), "coherence": ("real", 0, 100), "wide_below": ("int", 0, 1024),
         "appearance_window": ("int", 1, 15), "appearance_dims": ("int", 1, 64),
-        "coarsest_spacing": ("int", 0, 1024), "exhaustive": "bool"}),
+        "coarsest_spacing": ("int", 0, 1024), "exhaustive": "bool", "refine_passes": ("int", 0, 16),
+        "refine_patch": ("int", 2, 32), "refine_stride": ("int", 1, 32), "refine_random": ("int", 0, 16),
+        "refine_medoid": "bool"}),
     "diffuse_direction_field": (call("diffuse_direction_field", VERTS, FACES, GIVEN), {
         "weights": "str", "seed": "seed", "ctx": "ctx"}),
     "preset_direction_field": (call("preset_direction_field", VERTS, FACES), {"preset": "str", "ctx": "ctx"}),

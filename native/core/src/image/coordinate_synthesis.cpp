@@ -11,6 +11,7 @@
 #include "exsynth/parallel.hpp"
 #include "exsynth/pyramid.hpp"
 #include "exsynth/rng.hpp"
+#include "image/patch_refinement.hpp"
 #include "search/kd_tree.hpp"
 
 namespace exsynth::image {
@@ -70,6 +71,17 @@ void check_coordinate_options(const CoordinateSynthesisOptions& o) {
     throw InvalidInput("appearance_window must be odd, from 1 to 15 pixels, got " + std::to_string(o.appearance_window));
   if (o.appearance_dims < 1 || o.appearance_dims > 64)
     throw InvalidInput("appearance_dims must be between 1 and 64, got " + std::to_string(o.appearance_dims));
+  if (o.refine_passes < 0 || o.refine_passes > 16)
+    throw InvalidInput("refine_passes must be between 0 and 16 (0 = no patch refinement), got " +
+                       std::to_string(o.refine_passes));
+  if (o.refine_patch < 2 || o.refine_patch > 32)
+    throw InvalidInput("refine_patch must be between 2 and 32 pixels, got " + std::to_string(o.refine_patch));
+  if (o.refine_stride < 1 || o.refine_stride > o.refine_patch)
+    throw InvalidInput("refine_stride must be between 1 and refine_patch (" + std::to_string(o.refine_patch) +
+                       ") pixels, got " + std::to_string(o.refine_stride));
+  if (o.refine_random < 0 || o.refine_random > 16)
+    throw InvalidInput("refine_random must be between 0 and 16 probes per radius, got " +
+                       std::to_string(o.refine_random));
   if (o.coarsest_spacing != 0 && (!pow2(o.coarsest_spacing) || o.coarsest_spacing > 1024))
     throw InvalidInput("coarsest_spacing must be 0 (automatic) or a power of two from 1 to 1024, got " +
                        std::to_string(o.coarsest_spacing));
@@ -110,7 +122,8 @@ CoordinateSolver::CoordinateSolver(const Image& exemplar, const CoordinateSynthe
   // A window larger than the exemplar shrinks to the largest odd size that fits.
   int n = std::min(opt.appearance_window, std::min(W, H));
   if (n % 2 == 0) --n;
-  const Image scaled = analysis_copy(exemplar);
+  scaled_ = analysis_copy(exemplar);
+  const Image& scaled = scaled_;
   std::vector<float> ch_lo(std::size_t(C), 0.0f), ch_hi(std::size_t(C), 1.0f);
   // pca_variance 1: keep appearance_dims components (LH06 keep 8 of 5 x 5 x 3).
   // The index's own k-coherence sets (8 one-pixel shifts re-ranked per
@@ -401,10 +414,12 @@ CoordImage CoordinateSolver::synthesize(int width, int height, ExecContext* ctx,
   for (std::size_t l = 0; l < L; ++l) remaining += double(ws[l]) * hs[l];
   const int passes = std::max(opt_.corrections, 0);
   CoordImage s;
+  // The patch refinement's share of the progress: about what it costs.
+  const double levels_hi = opt_.refine_passes > 0 ? lo + 0.6 * (hi - lo) : hi;
   double at = lo;
   for (std::size_t l = 0; l < L; ++l) {
     const double pixels = double(ws[l]) * hs[l];
-    const double next = at + (hi - at) * pixels / remaining;
+    const double next = at + (levels_hi - at) * pixels / remaining;
     remaining -= pixels;
     StageProgress progress(ctx, "image: level " + std::to_string(l + 1) + "/" + std::to_string(L) + " (coordinates)", at,
                            next, std::size_t(std::max(passes, 1)) * 2 * std::size_t(hs[l]));
@@ -420,6 +435,7 @@ CoordImage CoordinateSolver::synthesize(int width, int height, ExecContext* ctx,
     }
     at = next;
   }
+  PatchRefiner(scaled_, lowest(), highest(), opt_, tileable_, seed_).run(s, ctx, levels_hi, hi, energy);
   return s;
 }
 
@@ -457,11 +473,13 @@ Image synthesize_coordinates(const Image& exemplar, const ImageSynthesisOptions&
   {
     // Peak: the index's windows (n^2 C floats per pixel) and coefficients,
     // the appearance stack (8 floats per pixel per level, ~log2(edge)
-    // levels), and per output pixel two coordinate images and the colours.
+    // levels), and per output pixel two coordinate images and the colours
+    // (the patch refinement: one more coordinate image and gathered colours).
     const double n = opt.coordinates.appearance_window, px = double(ex->pixel_count());
     const double levels = std::log2(std::max(2, std::min(ex->width(), ex->height()))) + 1;
     const double bytes = 4.0 * px * (n * n * ex->channels() + 8.0 * (levels + 2)) +
-                         double(opt.width) * opt.height * (16.0 + 4.0 * ex->channels());
+                         double(opt.width) * opt.height * (16.0 + 4.0 * ex->channels()) *
+                             (opt.coordinates.refine_passes > 0 ? 2.0 : 1.0);
     check_memory_budget(bytes, opt.memory_budget,
                         "image synthesis of " + std::to_string(opt.width) + "x" + std::to_string(opt.height) +
                             " from a " + std::to_string(ex->width()) + "x" + std::to_string(ex->height()) +

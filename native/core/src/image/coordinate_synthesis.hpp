@@ -89,6 +89,7 @@ class CoordinateSolver {
   void correct_pixel(const CoordImage& prev, CoordImage& out, int x, int y, int level, double& sum) const;
 
   Image exemplar_;
+  Image scaled_;  ///< the exemplar scaled for the analysis (colour distances of the refinement)
   CoordinateSynthesisOptions opt_;
   bool tileable_;
   std::uint64_t seed_;
