@@ -185,8 +185,9 @@ struct CoordinateSynthesisOptions {
   /// moves by round(h * r * U(-1, 1)) per axis at levels of spacing h >=
   /// jitter_from (LH05's J_l). More jitter = smaller coherent patches (less
   /// copying) but more seams (higher nn_rel); docs/solid.md has the sweep.
-  /// 0.5 with the patch refinement (0.25 without it; docs/solid.md).
-  double jitter = 0.5;
+  /// 0.25: the least that keeps copy_rate <= 0.35 on the 8 exemplars; with
+  /// the patch refinement below, 0.5 (docs/solid.md).
+  double jitter = 0.25;
   int jitter_from = 8;           ///< finest spacing (power of two) that is still jittered
   int corrections = 2;           ///< correction passes per level (each of 4 sub-passes)
   /// k-coherence candidates per neighbour (1 = the coherent one only). LH05
@@ -214,11 +215,13 @@ struct CoordinateSynthesisOptions {
   /// refine_random random probes per halving radius), then each pixel takes
   /// the coordinate, among those its patches' matches propose, that is the
   /// medoid in colour of all of them (every pixel stays an exemplar pixel).
-  /// Defaults: the lowest nn_rel found on the 8 exemplars with copy_rate
-  /// <= 0.35 and sharpness >= 0.9 on each (one round, 12 x 12, stride 4,
-  /// with jitter 0.5: nn_rel 0.298 vs 0.313 without; more rounds, larger
-  /// patches or stride 2 copy more; docs/solid.md has the sweep).
-  int refine_passes = 1;
+  /// Off by default: its best setting on the 8 exemplars with copy_rate <=
+  /// 0.35 and sharpness >= 0.9 on each (one round, 12 x 12, stride 4, with
+  /// jitter 0.5) gains only 0.015 of nn_rel (0.298 vs 0.313) for more
+  /// copying (0.31 vs 0.28) and a picture no better (brick's mortar as
+  /// broken, more short bricks); more rounds, larger patches or stride 2
+  /// copy more (docs/solid.md has the sweep).
+  int refine_passes = 0;
   int refine_patch = 12;
   int refine_stride = 4;
   int refine_random = 1;
