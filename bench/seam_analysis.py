@@ -27,18 +27,7 @@ def classes(E, out, quality, stride=2, copy_eps=1.0, min_cells=16):
     oy, ox = np.mgrid[0:gh, 0:gw] * stride
     offset = (sy - oy) * 100003 + (sx - ox)
     exact = rms * E.contrast < copy_eps
-    copied = np.zeros_like(exact)
-    best = 0
-    for t in np.unique(offset[exact]):
-        lab, n = quality.label4(exact & (offset == t))
-        sizes = np.bincount(lab.ravel())[1:]
-        for c in np.nonzero(sizes >= min_cells)[0] + 1:
-            cells = lab == c
-            copied |= cells
-            foot = np.zeros(out.shape[:2], bool)
-            for i, j in np.argwhere(cells):
-                foot[i * stride:i * stride + E.k, j * stride:j * stride + E.k] = True
-            best = max(best, int(foot.sum()))
+    copied, best = quality.copied_regions(exact, offset, stride, E.k, out.shape, min_cells)
     seam = ~exact
     e = rms[seam]
     return dict(nn_rel=float(rms.mean()), sharp=quality.grad_energy(out) / max(E.grad, 1e-9), copied=float(copied.mean()),

@@ -130,6 +130,26 @@ def label4(mask):
     return lab, n
 
 
+def copied_regions(exact, offset, stride, k, shape, min_cells=16):
+    """Verbatim copying from the patch grid: `exact` patches (RMS < copy_eps)
+    in 4-connected groups of >= min_cells sharing one exemplar `offset`.
+    Returns (copied: bool per patch, pixel area of the largest group's
+    footprint in an output of `shape`)."""
+    copied = np.zeros_like(exact)
+    best = 0
+    for t in np.unique(offset[exact]):
+        lab, n = label4(exact & (offset == t))
+        sizes = np.bincount(lab.ravel())[1:]
+        for c in np.nonzero(sizes >= min_cells)[0] + 1:
+            cells = lab == c
+            copied |= cells
+            foot = np.zeros(shape[:2], bool)
+            for i, j in np.argwhere(cells):
+                foot[i * stride:i * stride + k, j * stride:j * stride + k] = True
+            best = max(best, int(foot.sum()))
+    return copied, best
+
+
 def image_metrics(E, out, stride=2, copy_eps=1.0, min_cells=16):
     """The numbers above for one 2D output against Exemplar E."""
     out = rgb(as_255(out))
@@ -141,18 +161,7 @@ def image_metrics(E, out, stride=2, copy_eps=1.0, min_cells=16):
     oy, ox = np.mgrid[0:gh, 0:gw] * stride
     offset = (sy - oy) * 100003 + (sx - ox)
     exact = rms < copy_eps
-    copied = np.zeros_like(exact)
-    best = 0
-    for t in np.unique(offset[exact]):
-        lab, n = label4(exact & (offset == t))
-        sizes = np.bincount(lab.ravel())[1:]
-        for c in np.nonzero(sizes >= min_cells)[0] + 1:
-            cells = lab == c
-            copied |= cells
-            foot = np.zeros(out.shape[:2], bool)
-            for i, j in np.argwhere(cells):
-                foot[i * stride:i * stride + k, j * stride:j * stride + k] = True
-            best = max(best, int(foot.sum()))
+    copied, best = copied_regions(exact, offset, stride, k, out.shape, min_cells)
     out_contrast = float(np.sqrt(out.reshape(-1, 3).var(0).mean()))
     return dict(nn_rms=float(rms.mean()), nn_rel=float(rms.mean() / max(E.contrast, 1e-9)),
                 hist_emd=hist_emd(E.img, out), sharpness=grad_energy(out) / max(E.grad, 1e-9),
