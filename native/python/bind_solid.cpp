@@ -5,6 +5,7 @@
 #include "arguments.hpp"
 #include "arrays.hpp"
 #include "exsynth/errors.hpp"
+#include "exsynth/format.hpp"
 #include "exsynth/solid.hpp"
 
 namespace py = pybind11;
@@ -123,6 +124,28 @@ py::list to_list(const std::vector<double>& v) {
 
 }  // namespace
 
+// synthesize_image's docstring, with the coordinate method's defaults read
+// from the core (written out, they went stale when a default moved).
+const std::string& image_doc() {
+  static const std::string doc = [] {
+    const CoordinateSynthesisOptions d;
+    auto flag = [](bool b) { return b ? "True" : "False"; };
+    return "2D texture synthesis: exemplar -> (height, width, C) float32 image (tileable=True to tile).\n"
+           "method='" + std::string(default_image_method_name()) + "' is the default. method='coordinates': Lefebvre & Hoppe 2005 "
+           "in appearance space: jitter=" + format_number(d.jitter) + ", jitter_from=" + std::to_string(d.jitter_from) +
+           ", corrections=" + std::to_string(d.corrections) + ", candidates_k=" + std::to_string(d.coherence_k) +
+           ",\ncoherence=" + format_number(d.coherence) + ", wide_below=" + std::to_string(d.wide_below) +
+           ", appearance_window=" + std::to_string(d.appearance_window) + ", appearance_dims=" + std::to_string(d.appearance_dims) +
+           ", coarsest_spacing=" + std::to_string(d.coarsest_spacing) + " (auto), exhaustive=" + flag(d.exhaustive) +
+           ",\nrefine_passes=" + std::to_string(d.refine_passes) + " (the patch refinement: 0 = off), refine_patch=" +
+           std::to_string(d.refine_patch) + ", refine_stride=" + std::to_string(d.refine_stride) + ", refine_random=" +
+           std::to_string(d.refine_random) + ", refine_medoid=" + flag(d.refine_medoid) +
+           "; also tileable, max_exemplar_size, seed.\nmethod='optimization': the optimiser of synthesize_solid, "
+           "same options. Returns {'image': ..., 'energy': [...]}.";
+  }();
+  return doc;
+}
+
 void bind_solid(py::module_& m) {
   m.def(
       "min_texture_size",
@@ -226,14 +249,10 @@ Returns {'solid': (Z, Y, X, C) float32, 'energy': [...], 'energy_level': [...]}.
         out["image"] = take_vector(std::move(img.values()), {h, w, c});
         return out;
       },
-      py::arg("exemplar"), py::kw_only(), py::arg("width") = 128, py::arg("height") = 128,
+      py::arg("exemplar"), py::kw_only(), py::arg("width") = ImageSynthesisOptions{}.width,
+      py::arg("height") = ImageSynthesisOptions{}.height,
       py::arg("ctx") = py::none(),
-      "2D texture synthesis: exemplar -> (height, width, C) float32 image (tileable=True to tile).\n"
-      "method='coordinates' (default; Lefebvre & Hoppe 2005 in appearance space: jitter=0.5, jitter_from=8,\n"
-      "corrections=2, candidates_k=1, coherence=1, wide_below=0, appearance_window=5, appearance_dims=8,\n"
-      "coarsest_spacing=0 (auto), exhaustive=False, refine_passes=1, refine_patch=12, refine_stride=4, refine_random=1, refine_medoid=True;\n"
-      "also tileable, max_exemplar_size, seed) or 'optimization' (the optimiser of\n"
-      "synthesize_solid, same options). Returns {'image': ..., 'energy': [...]}.");
+      image_doc().c_str());
 }
 
 }  // namespace exsynth::py_bind
