@@ -121,8 +121,8 @@ enum class SolidMethod {
   /// view), synthesized coarse to fine by coordinate upsampling and
   /// correction passes among k-coherence candidates in appearance space
   /// (PCA of 5x5 neighbourhoods); colours are looked up at the end. Uses
-  /// levels, iterations (correction passes; coarsest 2x, finest as
-  /// finest_iterations), coordinate_coherence_k, pca_variance / max_pca_dims (at most
+  /// levels, iterations (correction passes at the coarsest level; one at
+  /// each finer level, the finest as finest_iterations), coordinate_coherence_k, pca_variance / max_pca_dims (at most
   /// kCoordinateFeatureDims), max_exemplar_size, tileable, memory_budget and
   /// seed; the optimiser's other options do not apply. No constraint volume
   /// and no feature channel yet. See docs/solid.md.
