@@ -172,7 +172,7 @@ def _parser():
                    help="optimisation rounds per level (default %(default)s)")
     p.add_argument("--method", choices=_native.SOLID_METHODS, default=_native.SOLID_DEFAULT_METHOD,
                    help="optimization (Kopf et al. 2007) or coordinates (exemplar coordinates, Dong et al. 2008: "
-                   "crisper slices, streaks on oblique cuts) (default %(default)s)")
+                   "crisper slices, square blocks on oblique cuts) (default %(default)s)")
     p.add_argument("--seed", type=_seed, default=0, help="random seed (default 0)")
     p.add_argument("--alpha", action="store_true", help="synthesize the exemplars' alpha as a 4th channel")
     p.add_argument("--scale", type=_finite, default=0.0,

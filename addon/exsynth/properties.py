@@ -22,7 +22,8 @@ _SOLID_METHOD_TEXT = {
     "optimization": ("Optimization", "Texture optimisation of voxel values (Kopf et al. 2007): softer, takes "
                      "the Python API's constraint volume"),
     "coordinates": ("Coordinates", "Exemplar coordinates with crossbar candidates (Dong et al. 2008): every "
-                    "voxel is a texel of the exemplar: crisper slices, faster, but streaks on oblique cuts"),
+                    "voxel is a texel of the exemplar: crisper slices, but square blocks with straight seams "
+                    "on oblique cuts"),
 }
 SOLID_METHOD_ITEMS = tuple((m.upper(), *_SOLID_METHOD_TEXT.get(m, (m.title(), m))) for m in _native.SOLID_METHODS)
 

@@ -141,10 +141,11 @@ SolidMethod solid_method_from_name(const std::string& name);
 
 struct SolidOptions : TextureOptimizationOptions {
   int size = 64;  ///< output edge length in voxels (size^3)
-  /// Coordinates meets more of issue 10's slice targets (14 of 32 against
-  /// 9 at 64^3) in about half the CPU at 128^3, but the demo's cow (oblique
-  /// cuts) shows streaks where a view's texel is extruded along its axis, so
-  /// the optimiser stays the default (docs/solid.md, fourth pass).
+  /// Coordinates meets more of issue 10's slice targets (20 of 32 against
+  /// 9 at 64^3, sixth pass) in about the optimiser's time at 128^3, but the
+  /// demo's cow (oblique cuts) shows square blocks of crisp texture with
+  /// straight seams, not the exemplar's stones, so the optimiser stays the
+  /// default (docs/solid.md, fourth to sixth passes).
   SolidMethod method = SolidMethod::Optimization;
   /// Coordinates: k-coherence candidates per neighbour's texel (its most
   /// similar texels). 0 = the neighbours' own texels only: measured as good
