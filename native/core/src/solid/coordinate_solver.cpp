@@ -10,14 +10,16 @@
 namespace exsynth::solid {
 namespace {
 
+/// Edge of the coarsest level's start cells (each copies one table triple,
+/// shifted with the voxel's offset). 4 instead of 8 (with the Euclidean
+/// costs and fewer passes below): 64^3 crackedground / stone33 hist_emd
+/// 3.39 / 9.82 -> 1.99 / 8.75 and voxels equal 4 steps away 0.24 -> 0.18 /
+/// 0.16 (docs/solid.md, sixth pass).
+constexpr int kInitCell = 4;
+
 /// Sub-pass class of coordinate x along an axis of n voxels: its parity,
 /// except that with an odd n and wrapping, the last voxel (a neighbour of
 /// voxel 0 and of n - 2) gets a class of its own.
-// 4 instead of 8 (with the Euclidean costs and fewer passes below): 64^3
-// crackedground / stone33 hist_emd 3.39 / 9.82 -> 1.99 / 8.75 and voxels
-// equal 4 steps away 0.24 -> 0.18 / 0.16 (docs/solid.md, sixth pass).
-constexpr int kInitCell = 4;
-
 int parity_class(int x, int n, bool wrap) { return wrap && (n & 1) && x == n - 1 ? 2 : (x & 1); }
 
 }  // namespace
