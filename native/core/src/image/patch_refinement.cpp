@@ -67,7 +67,12 @@ float PatchRefiner::distance(const CoordImage& s, int px, int py, Coord e, int n
 std::vector<Coord> PatchRefiner::match_candidates(const CoordImage& s, const std::vector<Coord>& nn, int gx, int gy,
                                                   int round, Coord best, bool probes) const {
   const int n = patch(s);
-  const std::vector<int> xs = corners(s.width, n), ys = corners(s.height, n);
+  return match_candidates(s, nn, n, corners(s.width, n), corners(s.height, n), gx, gy, round, best, probes);
+}
+
+std::vector<Coord> PatchRefiner::match_candidates(const CoordImage& s, const std::vector<Coord>& nn, int n,
+                                                  const std::vector<int>& xs, const std::vector<int>& ys, int gx,
+                                                  int gy, int round, Coord best, bool probes) const {
   const int px = xs[std::size_t(gx)], py = ys[std::size_t(gy)];
   std::vector<Coord> out;
   auto add = [&](Coord e) {
@@ -129,7 +134,7 @@ double PatchRefiner::match(const CoordImage& s, std::vector<Coord>& nn, int roun
         float best_d = std::numeric_limits<float>::infinity();
         for (bool probes : {false, true}) {
           if (probes && (opt_.exhaustive || opt_.refine_random <= 0)) break;
-          for (const Coord& e : match_candidates(s, prev, int(gx), int(gy), round, best, probes)) {
+          for (const Coord& e : match_candidates(s, prev, n, xs, ys, int(gx), int(gy), round, best, probes)) {
             const float d = distance(out, px, py, e, n, best_d);
             if (d < best_d) best_d = d, best = e;
           }

@@ -66,6 +66,11 @@ class PatchRefiner {
   bool valid(Coord e, int n) const {
     return e.u >= lo_.u && e.v >= lo_.v && e.u + n - 1 <= hi_.u && e.v + n - 1 <= hi_.v;
   }
+  /// match_candidates with the patch edge and the corners given (match()
+  /// computes them once per round, not once per patch).
+  std::vector<Coord> match_candidates(const CoordImage& s, const std::vector<Coord>& nn, int n,
+                                      const std::vector<int>& xs, const std::vector<int>& ys, int gx, int gy,
+                                      int round, Coord best, bool probes) const;
   /// Colours at the output's coordinates, padded by n - 1 (wrapped when tileable) so patches read rows.
   Image gather(const CoordImage& s, int n) const;
   float distance(const Image& out, int px, int py, Coord e, int n, float bound) const;
