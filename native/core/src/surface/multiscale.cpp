@@ -578,13 +578,12 @@ class MultiscaleSolver {
   };
 
   /// Brute force at the coarsest level: the pixel for texel t from the
-  /// distances d2 of its neighbourhood to every candidate row (d2 is
-  /// reordered). The best coherent candidate (see coherent_candidates) wins
+  /// distances d2 of its neighbourhood to every candidate row. The best coherent candidate (see coherent_candidates) wins
   /// unless the best of all is more than (1 + coherence) closer, as in the
   /// k-d tree passes: the coarsest level decides the patches every finer
   /// level copies, and the exact nearest alone broke them up (flat-plane
   /// window distance 0.413 without, 0.341 with it, 10 seeds, 400 windows).
-  Source brute_pick(int l, std::size_t t, const Layout& lay, const PassIndex& ix, std::vector<float>& d2,
+  Source brute_pick(int l, std::size_t t, const Layout& lay, const PassIndex& ix, const std::vector<float>& d2,
                     const std::vector<char>* visited, BruteScratch& s, std::uint64_t stream) const {
     const int P = int(d2.size()), k = std::min(opt_.knn, P);
     float coh_d2 = std::numeric_limits<float>::infinity();
