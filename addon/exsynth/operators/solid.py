@@ -144,9 +144,9 @@ class SolidJob(Job):
     exemplar: np.ndarray            # (H, W, C) float32, row 0 at the top
     exemplar_y: np.ndarray = None
     exemplar_z: np.ndarray = None
-    size: int = 64
-    levels: int = 3
-    iterations: int = 3
+    size: int = _native.SOLID_DEFAULT_SIZE
+    levels: int = _native.DEFAULT_LEVELS
+    iterations: int = _native.DEFAULT_ITERATIONS
     method: str = None              # one of _native.SOLID_METHODS; None = the engine's default
     scale: float = 1.0              # edge length of one tile
     seed: int = 0
@@ -203,8 +203,8 @@ class ImageJob(Job):
     width: int = 256
     height: int = 256
     tileable: bool = False
-    levels: int = 3
-    iterations: int = 3
+    levels: int = _native.DEFAULT_LEVELS
+    iterations: int = _native.DEFAULT_ITERATIONS
     seed: int = 0
     memory_budget: int = 0
     method: str = None              # one of _native.IMAGE_METHODS; None = the engine's default
