@@ -13,7 +13,12 @@ the same run, median of 3) and a 128^3 RGB solid.
 Exemplar sources: assets/textures (bundled), the Debian packages gimp-data
 (/usr/share/gimp/2.0/patterns) and assimp-testmodels (/usr/share/assimp).
 
-usage: bench_quality.py --build BUILD_DIR [--full] [--exemplars a,b] [--no-peers]
+Then a calibration of nn_rel ("the texture itself"): each exemplar's right
+half scored against its left half, beside a synthesis (and G'MIC's) from that
+left half: an unseen piece of the same texture is the score a synthesis that
+does not copy can hope for.
+
+usage: bench_quality.py --build BUILD_DIR [--full] [--exemplars a,b] [--no-peers] [--no-calibration]
 """
 import argparse
 import os
@@ -82,6 +87,45 @@ def whole_process(cmd, env=None):
     return wall, (r1.ru_utime - r0.ru_utime) + (r1.ru_stime - r0.ru_stime)
 
 
+CALIBRATION_WIDTHS = (9, 9, 7, 9, 7)  # held-out, exsynth (copy), gmic (copy)
+
+
+def calibration(names, quality, native, image_opts, peers, tmp):
+    """nn_rel of an unseen piece of each texture, beside syntheses from the rest.
+
+    The exemplar's left half (128 x 64) is the exemplar here; its right half,
+    never seen by anyone, scores what the texture itself scores; exsynth and
+    G'MIC make 128^2 from the left half. A synthesis far below the held-out
+    score is closer to a copy than the texture is to itself.
+    """
+    print()
+    print("calibration of nn_rel: left half (128 x 64) as exemplar; its right half (the texture itself, unseen) "
+          "against syntheses 128^2 from the left half")
+    head = f"{'exemplar':<16} {'held-out':>9} {'exsynth':>9} {'(copy)':>7}" + (f" {'gmic':>9} {'(copy)':>7}" if peers else "")
+    print(head)
+    print("-" * len(head))
+    sums = []
+    for name in names:
+        ex = exemplar(name)
+        left, right = np.ascontiguousarray(ex[:, :64]), np.ascontiguousarray(ex[:, 64:])
+        E = quality.Exemplar(left)
+        held = quality.image_metrics(E, right)
+        ours = quality.image_metrics(E, native.synthesize_image(left, width=128, height=128, seed=7, **image_opts)["image"])
+        vals = [held["nn_rel"], ours["nn_rel"], ours["copy_rate"]]
+        if peers:
+            png = os.path.join(tmp, name + "_left.png")
+            Image.fromarray(left).save(png)
+            subprocess.run(["gmic", "-v", "-1", png, "syntexturize_matchpatch", "128,128", "-o", png + ".out.png"],
+                           check=True, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+            theirs = quality.image_metrics(E, np.asarray(Image.open(png + ".out.png").convert("RGB")))
+            vals += [theirs["nn_rel"], theirs["copy_rate"]]
+        sums.append(vals)
+        print(f"{name:<16} " + " ".join(f"{v:>{w}.2f}" for v, w in zip(vals, CALIBRATION_WIDTHS)), flush=True)
+    mean = np.mean(sums, axis=0)
+    print("-" * len(head))
+    print(f"{'mean':<16} " + " ".join(f"{v:>{w}.2f}" for v, w in zip(mean, CALIBRATION_WIDTHS)))
+
+
 def row(label, m):
     return f"{label:<44} " + " ".join(f"{m[k]:>9.2f}" for k in KEYS)
 
@@ -94,6 +138,7 @@ def main(argv=None):
     ap.add_argument("--no-peers", action="store_true")
     ap.add_argument("--solids-only", action="store_true", help="only the solids (no images, peers or speed)")
     ap.add_argument("--options", default="", help="extra engine options, e.g. 'coherent_upsampling=False'")
+    ap.add_argument("--no-calibration", action="store_true", help="skip the held-out-half calibration of nn_rel")
     args = ap.parse_args(argv)
     sys.path.insert(0, os.path.join(args.build, "addon"))
     from exsynth import _native, quality
@@ -141,6 +186,8 @@ def main(argv=None):
 
     if args.solids_only:
         return 0
+    if not args.no_calibration:
+        calibration(names, quality, _native, image_opts, peers, tmp)
     print()
     print("speed (whole process, same run, alternating; median of 3)")
     env = dict(os.environ, PYTHONPATH=os.path.join(args.build, "addon"))
