@@ -149,7 +149,10 @@ struct SurfaceSynthesisOptions {
   int levels = 0;
   int fine_neighborhood = 9, coarse_neighborhood = 5;
   int knn = 4;                      ///< candidates from the k-d tree (re-ranked by exact distance)
-  double knn_tolerance = 0.0;       ///< random pick among those within this fraction of the best (paper: 0.1)
+  /// Random pick among those within this fraction of the best (paper: 0.1);
+  /// the coarsest level's brute force uses at least 0.1 (else two seeds can
+  /// grow the same texture from a small exemplar).
+  double knn_tolerance = 0.0;
   /// Multiscale: a coherent candidate (a neighbour's source shifted back by
   /// its offset) is taken unless the best k-d tree match is more than
   /// (1 + coherence) closer in squared distance; 0 = the k-d tree alone.
