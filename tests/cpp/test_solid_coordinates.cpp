@@ -7,13 +7,11 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
 #include <set>
 
 #include "exsynth/errors.hpp"
 #include "exsynth/rng.hpp"
 #include "exsynth/solid.hpp"
-#include "solid/coordinate_solver.hpp"
 #include "solid/crossbar_candidates.hpp"
 #include "solid/exemplar_index.hpp"
 #include "support/cancel.hpp"
@@ -111,61 +109,6 @@ TEST(SolidCoordinates, EveryVoxelIsAnExemplarTexel) {
   EXPECT_LT(r.energy.back(), r.energy.front());
 }
 
-// Brute force over the start's cell faces: the feature distance between each
-// voxel's texel moved one step across the face and the texel the voxel there
-// holds, summed, divided by the same step's change inside the block (what
-// the start's choice minimises, computed from the coordinates alone).
-double start_seam_ratio(const solid::CoordinateSolver& solver, const std::array<const solid::ExemplarIndex*, 3>& views, int n) {
-  const auto& coords = solver.coordinates();
-  auto at = [&](int x, int y, int z) { return coords[(std::size_t((z + n) % n) * n + (y + n) % n) * n + (x + n) % n]; };
-  auto dist = [&](int i, std::int32_t a, std::int32_t b) {
-    const auto& f = views[i]->coefficients();
-    return double((f.row(a) - f.row(b)).norm());
-  };
-  double seam = 0, inner = 0;
-  for (int z = 0; z < n; ++z)
-    for (int y = 0; y < n; ++y)
-      for (int x = 0; x < n; ++x)
-        for (int axis = 0; axis < 3; ++axis) {
-          const std::array<int, 3> p{x, y, z};
-          if (p[axis] % 4 != 3) continue;  // the last voxel of a 4-voxel cell
-          std::array<int, 3> q = p;
-          ++q[axis];
-          const solid::Triple tp = at(p[0], p[1], p[2]), tq = at(q[0], q[1], q[2]);
-          for (int i = 0; i < 3; ++i) {
-            if (axis == i) continue;
-            const solid::ExemplarIndex& ix = *views[i];
-            const int du = axis == solid::col_axis(i), dv = 1 - du;
-            const std::int32_t moved = ix.clamped_index(ix.centre_u(tp[i]) + du, ix.centre_v(tp[i]) + dv);
-            seam += dist(i, moved, tq[i]);
-            inner += dist(i, moved, tp[i]);
-          }
-        }
-  return seam / inner;
-}
-
-TEST(SolidCoordinates, StartBlocksFitTheirNeighbours) {
-  // The coarsest level's 4^3 start cells each copy a block of one table
-  // triple; a random block per cell (start_candidates = 1, as before) leaves
-  // seams the corrections cannot mend. Chosen by their fit, the blocks'
-  // seams must be closer to the blocks' own texture.
-  const Image ex = disc_texture(32, 32, 3, 23, 10, 3.0f);
-  const std::vector<float> lo(3, 0.0f), hi(3, 1.0f);
-  const solid::ExemplarIndex ix(ex, 5, 0.95, 8, 0, 16, lo, hi, nullptr, "x", 0, 1);
-  const std::array<const solid::ExemplarIndex*, 3> views{&ix, &ix, &ix};
-  const solid::CrossbarCandidates table(views, 3, 1, 3, nullptr, "table", 0, 1);
-  const int n = 16;
-  auto start = [&](int candidates) {
-    solid::CoordinateSolver solver({n, n, n}, views, table, 0, true, 5, candidates);
-    StageProgress progress(nullptr, "", 0, 1, solver.units());
-    solver.initialize(progress);
-    return start_seam_ratio(solver, views, n);
-  };
-  const double random = start(1), chosen = start(solid::kStartCandidates);
-  std::printf("start seam / inner: random blocks %.3f, chosen %.3f\n", random, chosen);
-  EXPECT_LT(chosen, 0.8 * random);
-}
-
 // Fraction of voxels whose value equals their +1 neighbour's along `axis`.
 double equal_neighbours(const Volume& v, int axis) {
   std::size_t same = 0, n = 0;
@@ -260,7 +203,7 @@ TEST(SolidCoordinates, CancelInEveryStage) {
   EXPECT_DOUBLE_EQ(log.final_progress, 1.0);
   const std::vector<std::string> expected{"solid: level 1/2 exemplar analysis (neighbourhoods, PCA)",
                                           "solid: level 2/2 exemplar analysis (k-coherence sets)", "solid: level 1/2 crossbar candidates",
-                                          "solid: level 1/2 initialise", "solid: level 1/2 correction 1/2", "solid: level 2/2 upsample",
+                                          "solid: level 1/2 correction 1/2", "solid: level 2/2 upsample",
                                           "solid: level 2/2 correction 2/2", "solid: colours"};
   for (const std::string& stage : expected) {
     EXPECT_NE(std::find(log.names.begin(), log.names.end(), stage), log.names.end()) << stage;

@@ -17,11 +17,6 @@ namespace {
 /// 0.16 (docs/solid.md, sixth pass).
 constexpr int kInitCell = 4;
 
-/// Offset of a voxel from the centre of its start cell.
-std::array<int, 3> cell_offset(const std::array<int, 3>& p) {
-  return {p[0] % kInitCell - kInitCell / 2, p[1] % kInitCell - kInitCell / 2, p[2] % kInitCell - kInitCell / 2};
-}
-
 /// Sub-pass class of coordinate x along an axis of n voxels: its parity,
 /// except that with an odd n and wrapping, the last voxel (a neighbour of
 /// voxel 0 and of n - 2) gets a class of its own.
@@ -30,10 +25,8 @@ int parity_class(int x, int n, bool wrap) { return wrap && (n & 1) && x == n - 1
 }  // namespace
 
 CoordinateSolver::CoordinateSolver(const std::array<int, 3>& dims, const std::array<const ExemplarIndex*, 3>& views,
-                                   const CrossbarCandidates& candidates, int coherence_k, bool wrap, std::uint64_t seed,
-                                   int start_candidates)
-    : dims_(dims), views_(views), table_(candidates), k_(coherence_k), start_candidates_(std::max(1, start_candidates)),
-      wrap_(wrap), seed_(seed),
+                                   const CrossbarCandidates& candidates, int coherence_k, bool wrap, std::uint64_t seed)
+    : dims_(dims), views_(views), table_(candidates), k_(coherence_k), wrap_(wrap), seed_(seed),
       coords_(std::size_t(dims[0]) * dims[1] * dims[2], Triple{-1, -1, -1}) {
   for (int i = 0; i < 3; ++i)
     if (views_[i]) {
@@ -58,62 +51,6 @@ std::int32_t CoordinateSolver::shift(int view, std::int32_t j, int du, int dv) c
   return ix.clamped_index(ix.centre_u(j) + du, ix.centre_v(j) + dv);
 }
 
-Triple CoordinateSolver::block_texels(const Triple& centre, const std::array<int, 3>& offset) const {
-  Triple t = centre;
-  for (int i = 0; i < 3; ++i)
-    if (views_[i]) t[i] = shift(i, centre[i], offset[col_axis(i)], offset[row_axis(i)]);
-  return t;
-}
-
-float CoordinateSolver::cell_fit(const std::array<int, 3>& cell, const Triple& centre, const std::array<int, 3>& cells,
-                                 const std::vector<Triple>& chosen, const std::vector<char>& placed) const {
-  auto cell_index = [&](const std::array<int, 3>& c) { return (std::size_t(c[2]) * cells[1] + c[1]) * cells[0] + c[0]; };
-  float cost = 0.0f, inner = 0.0f;
-  std::array<int, 3> lo{}, hi{};
-  for (int a = 0; a < 3; ++a) {
-    lo[a] = cell[a] * kInitCell;
-    hi[a] = std::min(lo[a] + kInitCell, dims_[a]);
-  }
-  std::array<int, 3> p{};
-  for (p[2] = lo[2]; p[2] < hi[2]; ++p[2])
-    for (p[1] = lo[1]; p[1] < hi[1]; ++p[1])
-      for (p[0] = lo[0]; p[0] < hi[0]; ++p[0])
-        for (int axis = 0; axis < 3; ++axis)
-          for (int s = -1; s <= 1; s += 2) {
-            // Only voxels on the cell's face toward an already placed cell.
-            if (p[axis] != (s < 0 ? lo[axis] : hi[axis] - 1)) continue;
-            std::array<int, 3> q = p;
-            q[axis] += s;
-            if (q[axis] < 0 || q[axis] >= dims_[axis]) {
-              if (!wrap_) continue;
-              q[axis] = (q[axis] + dims_[axis]) % dims_[axis];
-            }
-            const std::array<int, 3> qc{q[0] / kInitCell, q[1] / kInitCell, q[2] / kInitCell};
-            const std::size_t ci = cell_index(qc);
-            if (qc == cell || !placed[ci]) continue;
-            const Triple there = block_texels(chosen[ci], cell_offset(q));
-            const Triple here = block_texels(centre, cell_offset(p));
-            for (int i = 0; i < 3; ++i) {
-              if (!views_[i] || axis == i) continue;
-              const std::int32_t moved = axis == col_axis(i) ? shift(i, here[i], s, 0) : shift(i, here[i], 0, s);
-              const float* f = feature(i, moved);
-              const float* g = feature(i, there[i]);
-              const float* h = feature(i, here[i]);
-              float d2 = 0.0f, i2 = 0.0f;
-              for (int c = 0; c < dims_pca_[i]; ++c) {
-                d2 += (f[c] - g[c]) * (f[c] - g[c]);
-                i2 += (f[c] - h[c]) * (f[c] - h[c]);
-              }
-              cost += std::sqrt(d2);
-              inner += std::sqrt(i2);
-            }
-          }
-  // Relative to the block's own change: by the absolute mismatch the flattest
-  // blocks fit best and win (64^3 stone33 contrast 0.85 -> 0.75 with 16
-  // candidates; docs/solid.md, seventh pass).
-  return cost / (inner + 1e-3f);
-}
-
 void CoordinateSolver::initialize(StageProgress& progress) {
   std::array<int, 3> active{};
   int n_active = 0;
@@ -122,59 +59,24 @@ void CoordinateSolver::initialize(StageProgress& progress) {
   // Coherent patches, not texels: from per-voxel random triples the
   // parallel correction converges to the exemplar's flattest texels (every
   // neighbourhood is closest to the mean; seen at 32^3). Each cell of
-  // kInitCell^3 voxels copies one table triple, shifted with the voxel's
-  // offset from the cell's centre in every view (as a 3D block of the
-  // exemplars would be). The corrections cannot mend the seams between
-  // blocks that do not fit (a straight seam is their fixed point), so each
-  // cell picks, of start_candidates_ random triples, the one whose block fits
-  // the cells already placed best across their shared faces (image
-  // quilting's overlap match); cells are placed in classes of equal
-  // coordinate parity, so the choice is parallel and thread-count independent.
-  std::array<int, 3> cells{}, classes{};
-  for (int a = 0; a < 3; ++a) {
-    cells[a] = (dims_[a] + kInitCell - 1) / kInitCell;
-    classes[a] = wrap_ && (cells[a] & 1) && cells[a] > 1 ? 3 : std::min(cells[a], 2);
-  }
-  const std::size_t n_cells = std::size_t(cells[0]) * cells[1] * cells[2];
-  std::vector<Triple> chosen(n_cells, Triple{-1, -1, -1});
-  std::vector<char> placed(n_cells, 0);
-  for (int cz = 0; cz < classes[2]; ++cz)
-    for (int cy = 0; cy < classes[1]; ++cy)
-      for (int cx = 0; cx < classes[0]; ++cx) {
-        std::vector<std::size_t> members;
-        for (std::size_t c = 0; c < n_cells; ++c) {
-          const std::array<int, 3> q{int(c % cells[0]), int(c / cells[0] % cells[1]), int(c / cells[0] / cells[1])};
-          if (parity_class(q[0], cells[0], wrap_) == cx && parity_class(q[1], cells[1], wrap_) == cy &&
-              parity_class(q[2], cells[2], wrap_) == cz)
-            members.push_back(c);
-        }
-        progress.check();
-        StageProgress unreported(nullptr, "", 0.0, 0.0, 1);  // the class's cells: checked above, counted below
-        parallel_chunks(members.size(), 1, unreported, [&](std::size_t m0, std::size_t m1) {
-          for (std::size_t m = m0; m < m1; ++m) {
-            const std::size_t c = members[m];
-            const std::array<int, 3> q{int(c % cells[0]), int(c / cells[0] % cells[1]), int(c / cells[0] / cells[1])};
-            IndexRng rng(seed_, c, 0xC00D);
-            float best_cost = std::numeric_limits<float>::max();
-            for (int k = 0; k < start_candidates_; ++k) {
-              const int view = active[rng.below(std::uint64_t(n_active))];
-              const auto j = std::int32_t(rng.below(std::uint64_t(views_[view]->count())));
-              const Triple t = table_.of(view, j)[0];
-              const float cost = start_candidates_ > 1 ? cell_fit(q, t, cells, chosen, placed) : 0.0f;
-              if (cost < best_cost) {
-                best_cost = cost;
-                chosen[c] = t;
-              }
-            }
-          }
-        });
-        for (std::size_t c : members) placed[c] = 1;
-      }
+  // kInitCell^3 voxels copies one random table triple, shifted with the
+  // voxel's offset from the cell's centre in every view (as a 3D block of
+  // the exemplars would be); the corrections then mend the seams.
+  const int cells = (std::max({dims_[0], dims_[1], dims_[2]}) + kInitCell - 1) / kInitCell;
   parallel_chunks(coords_.size(), 1 << 14, progress, [&](std::size_t v0, std::size_t v1) {
     for (std::size_t v = v0; v < v1; ++v) {
       const std::array<int, 3> p{int(v % dims_[0]), int(v / dims_[0] % dims_[1]), int(v / dims_[0] / dims_[1])};
-      const std::size_t c = (std::size_t(p[2] / kInitCell) * cells[1] + p[1] / kInitCell) * cells[0] + p[0] / kInitCell;
-      coords_[v] = block_texels(chosen[c], cell_offset(p));
+      const std::uint64_t cell = (std::uint64_t(p[2] / kInitCell) * cells + p[1] / kInitCell) * cells + p[0] / kInitCell;
+      IndexRng rng(seed_, cell, 0xC00D);
+      const int view = active[rng.below(std::uint64_t(n_active))];
+      const auto j = std::int32_t(rng.below(std::uint64_t(views_[view]->count())));
+      Triple t = table_.of(view, j)[0];
+      for (int i = 0; i < 3; ++i) {
+        if (!views_[i]) continue;
+        const int a = col_axis(i), b = row_axis(i);
+        t[i] = shift(i, t[i], p[a] % kInitCell - kInitCell / 2, p[b] % kInitCell - kInitCell / 2);
+      }
+      coords_[v] = t;
     }
   });
 }

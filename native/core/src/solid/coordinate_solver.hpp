@@ -19,25 +19,15 @@
 
 namespace exsynth::solid {
 
-/// Random table triples each start cell of the coarsest level chooses from
-/// (1: a random block, as before). 4 and 16 against 1, 64^3 seed 7
-/// (docs/solid.md, seventh pass): targets met over the 8 exemplars 20 ->
-/// 22 / 21; granite1 contrast 0.82 -> 0.94, stone33 hist_emd 8.27 -> 7.14;
-/// nn_rel 0.01-0.07 worse.
-constexpr int kStartCandidates = 4;
-
 class CoordinateSolver {
  public:
   /// `views` (nullptr = inactive) are this level's exemplar analyses, whose
   /// PCA coefficients are the appearance-space features; they and
   /// `candidates` must outlive the solver.
   CoordinateSolver(const std::array<int, 3>& dims, const std::array<const ExemplarIndex*, 3>& views,
-                   const CrossbarCandidates& candidates, int coherence_k, bool wrap, std::uint64_t seed,
-                   int start_candidates = kStartCandidates);
+                   const CrossbarCandidates& candidates, int coherence_k, bool wrap, std::uint64_t seed);
 
-  /// Coarsest level: cells of 4^3 voxels, each a block of one table triple
-  /// (shifted with the voxel's offset), chosen of `start_candidates` seeded
-  /// random triples by its fit to the cells placed before it.
+  /// Coarsest level: each voxel a random table triple (seeded per voxel).
   void initialize(StageProgress& progress);
   /// Finer level: each voxel's texel in view i is 2 * (its parent's) + its
   /// offset from the parent along that view's slice axes; the child one step
@@ -67,15 +57,6 @@ class CoordinateSolver {
   const float* feature(int view, std::int32_t j) const { return features_[view] + std::size_t(j) * dims_pca_[view]; }
   /// Per view: how far the voxel's texel's crossbar neighbourhood is from its neighbours' texels.
   std::array<float, 3> view_costs(const std::array<int, 3>& p) const;
-  /// The texels of the block a start cell copies: `centre` shifted by the
-  /// voxel's offset from the cell's centre along each view's slice axes.
-  Triple block_texels(const Triple& centre, const std::array<int, 3>& offset) const;
-  /// How badly the block of `centre` in start cell `cell` fits the blocks of
-  /// the cells already placed across their shared faces: the Euclidean
-  /// feature distances across the faces (as the corrections count them)
-  /// divided by the block's own change over the same steps.
-  float cell_fit(const std::array<int, 3>& cell, const Triple& centre, const std::array<int, 3>& cells,
-                 const std::vector<Triple>& chosen, const std::vector<char>& placed) const;
   /// Corrects one voxel; returns its cost.
   float correct_voxel(const std::array<int, 3>& p, std::vector<Triple>& candidates, Triple& best) const;
 
@@ -88,7 +69,6 @@ class CoordinateSolver {
   // at 64^3, stone33 contrast 0.84 / 0.82 -> 0.85, crackedground 0.92 -> 0.95
   // (docs/solid.md, sixth pass).
   const float consistency_ = 0.25f;
-  int start_candidates_;
   bool wrap_;
   std::uint64_t seed_;
   std::array<const float*, 3> features_{};
