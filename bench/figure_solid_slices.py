@@ -4,10 +4,12 @@
 Per exemplar of bench_quality.py (128^2, seed 7 unless --seed) one row: the
 exemplar's top-left size x size texels, then the z, y and x slices through
 the middle of a size^3 solid synthesized with --options, each enlarged
---zoom times (nearest neighbour), into OUT.png.
+--zoom times (nearest neighbour), into OUT.png. With --oblique, the three
+oblique planes of bench_solid_axes.py (through the middle) instead of the
+axis slices.
 
 usage: figure_solid_slices.py --build BUILD --out OUT.png [--exemplars crackedground,stone33]
-                              [--options "method='coordinates'"] [--size 64] [--zoom 3]
+                              [--options "method='coordinates'"] [--size 64] [--zoom 3] [--oblique]
 """
 import argparse
 import os
@@ -18,6 +20,7 @@ from PIL import Image
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from bench_quality import exemplar  # noqa: E402
+from bench_solid_axes import OBLIQUE, oblique_plane  # noqa: E402
 
 
 def to_rgb8(a):
@@ -36,6 +39,7 @@ def main(argv=None):
     ap.add_argument("--size", type=int, default=64)
     ap.add_argument("--seed", type=int, default=7)
     ap.add_argument("--zoom", type=int, default=3)
+    ap.add_argument("--oblique", action="store_true", help="oblique planes instead of the axis slices")
     args = ap.parse_args(argv)
     sys.path.insert(0, os.path.join(args.build, "addon"))
     from exsynth import _native
@@ -47,7 +51,10 @@ def main(argv=None):
         ex = exemplar(name)
         vol = to_rgb8(_native.synthesize_solid(ex, size=n, seed=args.seed, **opts)["solid"])  # (z, y, x, c)
         m = n // 2
-        tiles = [ex[:n, :n], vol[m], vol[:, m], vol[:, :, m]]  # exemplar, z-, y-, x-slice
+        if args.oblique:
+            tiles = [ex[:n, :n]] + [oblique_plane(vol, az, ax, m) for az, ax in OBLIQUE]
+        else:
+            tiles = [ex[:n, :n], vol[m], vol[:, m], vol[:, :, m]]  # exemplar, z-, y-, x-slice
         row = np.full((n, 4 * n + 3 * gap, 3), 255, np.uint8)
         for k, t in enumerate(tiles):
             row[:, k * (n + gap):k * (n + gap) + n] = t[..., :3]
