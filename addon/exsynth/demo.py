@@ -73,11 +73,12 @@ COW_LENGTH = 2.0  # the OBJ is 1 unit long
 SOLID_SCALE = 1.0  # one tile of the solid, in world units
 
 
-def run_solid(cow_path, exemplar_path, out_dir, size=64, samples=16):
+def run_solid(cow_path, exemplar_path, out_dir, size=64, samples=16, method=None, name="solid_texture.png"):
     """Solid-texture the bundled cow, cut open: the Solid Texture operator on
     the cow minus a box, Re-bake on the piece the box took out (then set
     beside it, cut face to the camera), so the cut faces of both show the
-    inside of the same block of stone."""
+    inside of the same block of stone. `method` (a SOLID_METHODS name; None:
+    the add-on's default) and `name` are for figures (bench/figure_solid_cow.py)."""
     t0 = time.perf_counter()
     bpy.ops.wm.read_homefile(use_empty=True)
     demo_stage.ensure_addon()
@@ -108,6 +109,8 @@ def run_solid(cow_path, exemplar_path, out_dir, size=64, samples=16):
     settings.solid_size = size
     settings.solid_scale = SOLID_SCALE
     settings.solid_bake_resolution = 1024
+    if method is not None:
+        settings.solid_method = method.upper()
     t1 = time.perf_counter()
     demo_stage.select([cow])
     result = bpy.ops.exsynth.solid_texture()
@@ -130,7 +133,7 @@ def run_solid(cow_path, exemplar_path, out_dir, size=64, samples=16):
     demo_stage.prepare_scene(scene, samples)
     centre = Vector((0.18 * dims.x, -0.6 * dims.y, 0.4 * dims.z))
     demo_stage.aim_camera(scene, centre, distance=4.6, side=0.3)
-    demo_stage.render(scene, os.path.join(out_dir, "solid_texture.png"))
+    demo_stage.render(scene, os.path.join(out_dir, name))
     t4 = time.perf_counter()
     print(f"demo: solid {size}³ from {os.path.basename(exemplar_path)} and bake in {t2 - t1:.2f} s, "
           f"re-bake {t3 - t2:.2f} s; render {t4 - t3:.1f} s; total {t4 - t0:.1f} s -> {out_dir}")
