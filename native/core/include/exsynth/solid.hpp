@@ -230,6 +230,17 @@ struct CoordinateSynthesisOptions {
   /// their mean colour (false: less copying, lower nn_rel, but it favours
   /// mid-tones: lower sharpness; docs/solid.md).
   bool refine_medoid = true;
+  /// Seam cuts after the finest level and the refinement (cut_passes
+  /// sweeps, 0 = none; image/seam_cut.hpp): graph-cut expansion moves on
+  /// cut_window^2 windows move the seams between coherent regions to where
+  /// the two sources agree (Kwatra et al. 2003's seam cost), alpha over the
+  /// cut_labels commonest sources of each window; cut_leave is the cost (in
+  /// colour distance, the exemplar's units) a pixel pays for leaving the
+  /// synthesis's coordinate, which holds the regions' growth (copying) back.
+  int cut_passes = 0;
+  int cut_window = 32;
+  int cut_labels = 16;
+  double cut_leave = 0.0;
 };
 
 struct ImageSynthesisOptions : TextureOptimizationOptions {
