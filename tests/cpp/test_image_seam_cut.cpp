@@ -137,6 +137,19 @@ TEST(ImageSeamCut, PairCostIsKwatrasAndZeroInsideAPatch) {
   // p holds (3, 7), q = p + (1, 0) holds (9, 2): sources A = (3, 7) + ., B = (8, 2) + .
   EXPECT_NEAR(cut.pair_cost({3, 7}, {9, 2}, 1, 0), norm({3, 7}, {8, 2}) + norm({4, 7}, {9, 2}), 1e-5);
   EXPECT_NEAR(cut.pair_cost({3, 7}, {9, 2}, 0, 1), norm({3, 7}, {9, 1}) + norm({3, 8}, {9, 2}), 1e-5);
+  // cut_radius 1: the mean over the 3 x 3 pixels around each (clamped at the exemplar's edge).
+  CoordinateSynthesisOptions o = cutting(1, 8, 0);
+  o.cut_radius = 1;
+  const SeamCutter wide(ex, {0, 0}, {15, 15}, o, false);
+  auto at = [](int u, int v) { return Coord{std::clamp(u, 0, 15), std::clamp(v, 0, 15)}; };
+  for (auto [a, b] : {std::pair{Coord{3, 7}, Coord{9, 2}}, std::pair{Coord{0, 15}, Coord{15, 0}}}) {
+    double want = 0;
+    for (int dv = -1; dv <= 1; ++dv)
+      for (int du = -1; du <= 1; ++du)
+        want += norm(at(a.u + du, a.v + dv), at(b.u - 1 + du, b.v + dv)) + norm(at(a.u + 1 + du, a.v + dv), at(b.u + du, b.v + dv));
+    EXPECT_NEAR(wide.pair_cost(a, b, 1, 0), want / 9, 1e-5);
+  }
+  EXPECT_EQ(wide.pair_cost({4, 5}, {5, 5}, 1, 0), 0.0f);
 }
 
 TEST(ImageSeamCut, ExpansionIsTheBestOfEveryLabellingItAllows) {
@@ -144,8 +157,12 @@ TEST(ImageSeamCut, ExpansionIsTheBestOfEveryLabellingItAllows) {
   const Coord lo{1, 1}, hi{12, 12};
   for (bool tileable : {false, true})
     for (double leave : {0.0, 0.3})
+      for (int reach : {0, 1})
       for (std::uint64_t seed = 0; seed < 6; ++seed) {
-        const SeamCutter cut(ex, lo, hi, cutting(1, 8, leave), tileable);
+        CoordinateSynthesisOptions o = cutting(1, 8, leave);
+        o.cut_reach = reach;
+        o.cut_radius = int(seed % 2);  // Kwatra's pair cost, and the mean over 3 x 3 around
+        const SeamCutter cut(ex, lo, hi, o, tileable);
         const CoordImage start = random_coords(7, 6, lo, hi, seed + 10 * tileable);
         const SeamCutter::Window win{2, 1, 3, 3};  // 9 pixels: 512 labellings
         CoordImage s = start;
@@ -155,7 +172,15 @@ TEST(ImageSeamCut, ExpansionIsTheBestOfEveryLabellingItAllows) {
           for (int y = win.y0; y < win.y0 + win.h; ++y)
             for (int x = win.x0; x < win.x0 + win.w; ++x) {
               const Coord c{x + alpha.u, y + alpha.v};
-              if (c.u >= lo.u && c.v >= lo.v && c.u <= hi.u && c.v <= hi.v && !(c == s.at(x, y)))
+              // With a reach: some pixel of the padded window within `reach` already continues alpha.
+              bool near = reach == 0;
+              for (int yy = std::max(y - reach, win.y0 - 1); yy <= std::min(y + reach, win.y0 + win.h) && !near; ++yy)
+                for (int xx = std::max(x - reach, win.x0 - 1); xx <= std::min(x + reach, win.x0 + win.w) && !near; ++xx) {
+                  if (!tileable && (xx < 0 || yy < 0 || xx >= s.width || yy >= s.height)) continue;
+                  const Coord q = s.at((xx + s.width) % s.width, (yy + s.height) % s.height);
+                  near = q == Coord{xx + alpha.u, yy + alpha.v};
+                }
+              if (near && c.u >= lo.u && c.v >= lo.v && c.u <= hi.u && c.v <= hi.v && !(c == s.at(x, y)))
                 free.push_back(std::size_t(y) * s.width + x);
             }
           const double before = cut.energy(s, start);
@@ -173,7 +198,8 @@ TEST(ImageSeamCut, ExpansionIsTheBestOfEveryLabellingItAllows) {
           const double after = cut.energy(s, start);
           EXPECT_LE(delta, 0.0);
           EXPECT_NEAR(after, before + delta, 1e-4);
-          EXPECT_NEAR(after, best, 1e-4) << "tileable " << tileable << " leave " << leave << " seed " << seed;
+          EXPECT_NEAR(after, best, 1e-4) << "tileable " << tileable << " leave " << leave << " reach " << reach
+                                         << " seed " << seed;
         }
       }
 }
@@ -291,4 +317,6 @@ TEST(ImageSeamCut, BadOptionsNameTheOption) {
   EXPECT_THAT(message([](auto& o) { o.coordinates.cut_labels = 0; }), HasSubstr("cut_labels must be between 1 and 256"));
   EXPECT_THAT(message([](auto& o) { o.coordinates.cut_leave = -0.5; }), HasSubstr("cut_leave must be between 0 and"));
   EXPECT_THAT(message([](auto& o) { o.coordinates.cut_leave = std::nan(""); }), HasSubstr("cut_leave must be"));
+  EXPECT_THAT(message([](auto& o) { o.coordinates.cut_reach = -1; }), HasSubstr("cut_reach must be between 0 and 256"));
+  EXPECT_THAT(message([](auto& o) { o.coordinates.cut_radius = 5; }), HasSubstr("cut_radius must be between 0 and 4"));
 }

@@ -241,6 +241,12 @@ struct CoordinateSynthesisOptions {
   int cut_window = 32;
   int cut_labels = 16;
   double cut_leave = 0.0;
+  /// A move by source alpha reaches only pixels within cut_reach (Chebyshev)
+  /// of alpha's pixels (0 = the whole window).
+  int cut_reach = 4;
+  /// The seam cost compares the two sources over (2 cut_radius + 1)^2
+  /// pixels around each of the pair (the mean; 0 = the pair only, Kwatra's).
+  int cut_radius = 0;
 };
 
 struct ImageSynthesisOptions : TextureOptimizationOptions {

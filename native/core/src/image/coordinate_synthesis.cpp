@@ -92,6 +92,11 @@ void check_coordinate_options(const CoordinateSynthesisOptions& o) {
   if (!(o.cut_leave >= 0 && o.cut_leave <= 1e6))
     throw InvalidInput("cut_leave must be between 0 and 1e6 (colour distance per pixel), got " +
                        std::to_string(o.cut_leave));
+  if (o.cut_reach < 0 || o.cut_reach > 256)
+    throw InvalidInput("cut_reach must be between 0 and 256 pixels (0 = the whole window), got " +
+                       std::to_string(o.cut_reach));
+  if (o.cut_radius < 0 || o.cut_radius > 4)
+    throw InvalidInput("cut_radius must be between 0 and 4 pixels, got " + std::to_string(o.cut_radius));
   if (o.coarsest_spacing != 0 && (!pow2(o.coarsest_spacing) || o.coarsest_spacing > 1024))
     throw InvalidInput("coarsest_spacing must be 0 (automatic) or a power of two from 1 to 1024, got " +
                        std::to_string(o.coarsest_spacing));

@@ -21,8 +21,15 @@ float SeamCutter::pair_cost(Coord a, Coord b, int ex, int ey) const {
     for (int k = 0; k < C; ++k) d += (x[k] - y[k]) * (x[k] - y[k]);
     return std::sqrt(d);
   };
-  // Source A = a's patch at both pixels (a, a + e), source B = b's (b - e, b).
-  return norm(col(a.u, a.v), col(b.u - ex, b.v - ey)) + norm(col(a.u + ex, a.v + ey), col(b.u, b.v));
+  // Source A = a's patch at both pixels (a, a + e), source B = b's (b - e, b);
+  // with cut_radius r, over the (2r + 1)^2 pixels around each (the mean).
+  const int r = opt_.cut_radius;
+  float d = 0.0f;
+  for (int dv = -r; dv <= r; ++dv)
+    for (int du = -r; du <= r; ++du)
+      d += norm(col(a.u + du, a.v + dv), col(b.u - ex + du, b.v - ey + dv)) +
+           norm(col(a.u + ex + du, a.v + ey + dv), col(b.u + du, b.v + dv));
+  return r == 0 ? d : d / float((2 * r + 1) * (2 * r + 1));
 }
 
 long SeamCutter::index(const CoordImage& s, int x, int y) const {
@@ -117,14 +124,42 @@ double SeamCutter::expand(CoordImage& s, const CoordImage& start, const Window& 
   std::vector<Coord> cur(n), cand(n);
   std::vector<int> node(n, -1);
   std::vector<double> e0, e1;
+  std::vector<unsigned char> near(n, 1);
+  for (int j = 0; j < ph; ++j)
+    for (int i = 0; i < pw; ++i) {
+      const std::size_t k = std::size_t(j) * pw + i;
+      pix[k] = index(s, win.x0 - 1 + i, win.y0 - 1 + j);
+      if (pix[k] >= 0) cur[k] = cand[k] = s.s[std::size_t(pix[k])];
+    }
+  if (opt_.cut_reach > 0) {
+    // Only pixels within cut_reach (Chebyshev) of a pixel already on alpha
+    // may take it: a region grows by at most cut_reach per move.
+    std::vector<unsigned char> on(n, 0), rows(n, 0);
+    for (int j = 0; j < ph; ++j)
+      for (int i = 0; i < pw; ++i) {
+        const std::size_t k = std::size_t(j) * pw + i;
+        on[k] = pix[k] >= 0 && cur[k] == Coord{win.x0 - 1 + i + alpha.u, win.y0 - 1 + j + alpha.v};
+      }
+    const int r = opt_.cut_reach;
+    for (int j = 0; j < ph; ++j)
+      for (int i = 0; i < pw; ++i) {
+        unsigned char a = 0;
+        for (int t = std::max(0, i - r); t <= std::min(pw - 1, i + r) && !a; ++t) a = on[std::size_t(j) * pw + t];
+        rows[std::size_t(j) * pw + i] = a;
+      }
+    for (int j = 0; j < ph; ++j)
+      for (int i = 0; i < pw; ++i) {
+        unsigned char a = 0;
+        for (int t = std::max(0, j - r); t <= std::min(ph - 1, j + r) && !a; ++t) a = rows[std::size_t(t) * pw + i];
+        near[std::size_t(j) * pw + i] = a;
+      }
+  }
   int nodes = 0;
   for (int j = 0; j < ph; ++j)
     for (int i = 0; i < pw; ++i) {
       const std::size_t k = std::size_t(j) * pw + i;
+      if (pix[k] < 0 || !near[k]) continue;
       const int x = win.x0 - 1 + i, y = win.y0 - 1 + j;
-      pix[k] = index(s, x, y);
-      if (pix[k] < 0) continue;
-      cur[k] = cand[k] = s.s[std::size_t(pix[k])];
       const bool inside = i >= 1 && j >= 1 && i <= win.w && j <= win.h;
       const Coord c{x + alpha.u, y + alpha.v};
       if (inside && valid(c) && !(c == cur[k])) {
