@@ -244,8 +244,9 @@ Returns {'solid': (Z, Y, X, C) float32, 'energy': [...], 'energy_level': [...]}.
         opt.height = int_arg(height, "height", 1, 16384, "pixels");
         set_common(opt, set_image_options(opt, kw),
                    "method, jitter, jitter_from, corrections, candidates_k, coherence, wide_below, "
-                   "appearance_window, appearance_dims, coarsest_spacing, exhaustive, refine_passes, refine_patch, refine_stride, refine_random, refine_medoid, cut_passes, cut_window, cut_labels, cut_leave, cut_reach, cut_radius, tileable, max_exemplar_size, memory_budget, "
-                   "seed; with method='optimization' also synthesize_solid's (levels, neighborhood, iterations, ...)");
+                   "appearance_window, appearance_dims, coarsest_spacing, exhaustive, refine_{passes, patch, stride, random, medoid}, "
+                   "cut_{passes, window, labels, leave, reach, radius}, tileable, max_exemplar_size, memory_budget, "
+                   "seed; method='optimization' also takes synthesize_solid's");
         Image img;
         std::vector<double> energy;
         {
