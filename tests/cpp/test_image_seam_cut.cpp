@@ -256,10 +256,13 @@ TEST(ImageSeamCut, NeverRaisesTheEnergyAndLowersIt) {
 
 TEST(ImageSeamCut, SameSeedSameImageOnOneTwoAndEightThreads) {
   const Image ex = disc_texture(32, 32, 3, 64);
-  for (bool tileable : {false, true}) {
+  for (bool tileable : {false, true})
+  for (bool matches : {false, true}) {
     ImageSynthesisOptions o = small_cut_image();
     o.tileable = tileable;
     o.coordinates.jitter = 0.5;
+    o.coordinates.cut_matches = matches;  // the PatchMatch sources as alpha too
+    o.coordinates.refine_patch = 6;
     const Image one = exsynth::testing::on_threads(1, [&] { return synthesize_image(ex, o); });
     const Image two = exsynth::testing::on_threads(2, [&] { return synthesize_image(ex, o); });
     const Image eight = exsynth::testing::on_threads(8, [&] { return synthesize_image(ex, o); });
@@ -287,6 +290,8 @@ TEST(ImageSeamCut, EveryPixelIsAnExemplarPixel) {
 TEST(ImageSeamCut, CancelInEveryStage) {
   const Image ex = disc_texture(32, 32, 3, 66);
   ImageSynthesisOptions o = small_cut_image();
+  o.coordinates.cut_matches = true;
+  o.coordinates.refine_patch = 6;
   const auto job = [&](ExecContext* ctx) { synthesize_image(ex, o, ctx); };
   const auto log = exsynth::testing::stages_of(job);
   ASSERT_GE(log.names.size(), 4u);

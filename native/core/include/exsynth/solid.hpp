@@ -247,6 +247,10 @@ struct CoordinateSynthesisOptions {
   /// The seam cost compares the two sources over (2 cut_radius + 1)^2
   /// pixels around each of the pair (the mean; 0 = the pair only, Kwatra's).
   int cut_radius = 0;
+  /// Also try as alpha, in each window, the sources of the nearest exemplar
+  /// patches (PatchMatch of the refinement: refine_patch, refine_stride,
+  /// refine_random) of the output patches whose corners lie in the window.
+  bool cut_matches = false;
 };
 
 struct ImageSynthesisOptions : TextureOptimizationOptions {

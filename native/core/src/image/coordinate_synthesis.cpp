@@ -452,7 +452,7 @@ CoordImage CoordinateSolver::synthesize(int width, int height, ExecContext* ctx,
     at = next;
   }
   PatchRefiner(scaled_, lowest(), highest(), opt_, tileable_, seed_).run(s, ctx, levels_hi, cut_lo, energy);
-  SeamCutter(scaled_, lowest(), highest(), opt_, tileable_).run(s, ctx, cut_lo, hi, energy);
+  SeamCutter(scaled_, lowest(), highest(), opt_, tileable_, seed_).run(s, ctx, cut_lo, hi, energy);
   return s;
 }
 
@@ -491,12 +491,13 @@ Image synthesize_coordinates(const Image& exemplar, const ImageSynthesisOptions&
     // Peak: the index's windows (n^2 C floats per pixel) and coefficients,
     // the appearance stack (8 floats per pixel per level, ~log2(edge)
     // levels), and per output pixel two coordinate images and the colours
-    // (the patch refinement: one more coordinate image and gathered colours).
+    // (the patch refinement: one more coordinate image and gathered colours;
+    // the seam cuts: the synthesis's coordinates kept, and the matches).
     const double n = opt.coordinates.appearance_window, px = double(ex->pixel_count());
     const double levels = std::log2(std::max(2, std::min(ex->width(), ex->height()))) + 1;
     const double bytes = 4.0 * px * (n * n * ex->channels() + 8.0 * (levels + 2)) +
                          double(opt.width) * opt.height * (16.0 + 4.0 * ex->channels()) *
-                             (opt.coordinates.refine_passes > 0 ? 2.0 : 1.0);
+                             (opt.coordinates.refine_passes > 0 || opt.coordinates.cut_passes > 0 ? 2.0 : 1.0);
     check_memory_budget(bytes, opt.memory_budget,
                         "image synthesis of " + std::to_string(opt.width) + "x" + std::to_string(opt.height) +
                             " from a " + std::to_string(ex->width()) + "x" + std::to_string(ex->height()) +

@@ -6,12 +6,13 @@
 
 #include "exsynth/parallel.hpp"
 #include "image/max_flow.hpp"
+#include "image/patch_refinement.hpp"
 
 namespace exsynth::image {
 
 SeamCutter::SeamCutter(const Image& colours, Coord lowest, Coord highest, const CoordinateSynthesisOptions& opt,
-                       bool tileable)
-    : colours_(colours), lo_(lowest), hi_(highest), opt_(opt), tileable_(tileable) {}
+                       bool tileable, std::uint64_t seed)
+    : colours_(colours), lo_(lowest), hi_(highest), opt_(opt), tileable_(tileable), seed_(seed) {}
 
 float SeamCutter::pair_cost(Coord a, Coord b, int ex, int ey) const {
   const int W = colours_.width(), H = colours_.height(), C = colours_.channels();
@@ -113,6 +114,40 @@ std::vector<Coord> SeamCutter::sources(const CoordImage& s, const Window& win) c
   });
   std::vector<Coord> out;
   for (std::size_t k = 0; k < count.size() && int(k) < opt_.cut_labels; ++k) out.push_back(count[k].first);
+  return out;
+}
+
+SeamCutter::Matches SeamCutter::matches(const CoordImage& s, StageProgress& progress) const {
+  Matches m;
+  if (!opt_.cut_matches) return m;
+  const PatchRefiner refiner(colours_, lo_, hi_, opt_, tileable_, seed_);
+  m.n = refiner.patch(s);
+  m.xs = refiner.corners(s.width, m.n);
+  m.ys = refiner.corners(s.height, m.n);
+  refiner.match(s, m.nn, 0, progress);
+  return m;
+}
+
+std::vector<Coord> SeamCutter::match_sources(const CoordImage& s, const Matches& m, const Window& win,
+                                             const std::vector<Coord>& have) const {
+  std::vector<Coord> out;
+  if (m.nn.empty()) return out;
+  // A corner's position unwrapped into the window's range (tileable), or -1 when outside it.
+  auto local = [&](int c, int x0, int w, int size) {
+    if (tileable_) c = x0 + ((c - x0) % size + size) % size;
+    return c >= x0 && c < x0 + w ? c : -1;
+  };
+  for (std::size_t gy = 0; gy < m.ys.size(); ++gy) {
+    const int y = local(m.ys[gy], win.y0, win.h, s.height);
+    if (y < 0) continue;
+    for (std::size_t gx = 0; gx < m.xs.size(); ++gx) {
+      const int x = local(m.xs[gx], win.x0, win.w, s.width);
+      if (x < 0) continue;
+      const Coord e = m.nn[gy * m.xs.size() + gx], off{e.u - x, e.v - y};
+      if (std::find(have.begin(), have.end(), off) == have.end() && std::find(out.begin(), out.end(), off) == out.end())
+        out.push_back(off);
+    }
+  }
   return out;
 }
 
@@ -234,17 +269,27 @@ void SeamCutter::run(CoordImage& s, ExecContext* ctx, double lo, double hi, std:
   // Tileable images under 3 pixels across: a window would hold its own border.
   if (tileable_ && (s.width < 3 || s.height < 3)) return;
   std::size_t total = 0;
-  for (int pass = 0; pass < opt_.cut_passes; ++pass)
+  for (int pass = 0; pass < opt_.cut_passes; ++pass) {
     for (const auto& cls : windows(s, pass)) total += cls.size();
+    if (opt_.cut_matches) {  // the match advances once per row of patch corners
+      const PatchRefiner refiner(colours_, lo_, hi_, opt_, tileable_, seed_);
+      total += refiner.corners(s.height, refiner.patch(s)).size();
+    }
+  }
   StageProgress progress(ctx, "image: seam cuts", lo, hi, total);
   const CoordImage start = s;
   for (int pass = 0; pass < opt_.cut_passes; ++pass) {
+    const Matches m = matches(s, progress);
     for (const auto& cls : windows(s, pass)) {
       // Windows of one class never touch: each reads its own pixels and a
       // border no other window of the class writes.
       parallel_chunks(cls.size(), 1, progress, [&](std::size_t begin, std::size_t end) {
-        for (std::size_t w = begin; w < end; ++w)
-          for (const Coord& alpha : sources(s, cls[w])) expand(s, start, cls[w], alpha);
+        for (std::size_t w = begin; w < end; ++w) {
+          std::vector<Coord> alphas = sources(s, cls[w]);
+          const std::vector<Coord> more = match_sources(s, m, cls[w], alphas);
+          alphas.insert(alphas.end(), more.begin(), more.end());
+          for (const Coord& alpha : alphas) expand(s, start, cls[w], alpha);
+        }
       });
     }
     if (energy) energy->push_back(this->energy(s, start) / double(s.s.size()));

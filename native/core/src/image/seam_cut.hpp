@@ -38,7 +38,8 @@ namespace exsynth::image {
 class SeamCutter {
  public:
   /// `colours`: the (analysis-scaled) exemplar; coordinates stay in [lowest, highest].
-  SeamCutter(const Image& colours, Coord lowest, Coord highest, const CoordinateSynthesisOptions& opt, bool tileable);
+  SeamCutter(const Image& colours, Coord lowest, Coord highest, const CoordinateSynthesisOptions& opt, bool tileable,
+             std::uint64_t seed = 0);
 
   /// Seam cost between output neighbours p (coordinate a) and q = p + (ex, ey) (coordinate b).
   float pair_cost(Coord a, Coord b, int ex, int ey) const;
@@ -55,6 +56,18 @@ class SeamCutter {
   /// The sources tried as alpha in window `win` (offsets c - p, unwrapped
   /// positions), commonest first, at most cut_labels.
   std::vector<Coord> sources(const CoordImage& s, const Window& win) const;
+  /// The nearest exemplar patches of the output's patches (cut_matches): their
+  /// corners and matches, for match_sources.
+  struct Matches {
+    int n = 0;
+    std::vector<int> xs, ys;
+    std::vector<Coord> nn;
+  };
+  Matches matches(const CoordImage& s, StageProgress& progress) const;
+  /// The sources (offsets, unwrapped as the window's positions) of the
+  /// matches whose patch corners lie in `win`, not already in `have`.
+  std::vector<Coord> match_sources(const CoordImage& s, const Matches& m, const Window& win,
+                                   const std::vector<Coord>& have) const;
   /// One expansion move of `win` by source `alpha`, kept only when it lowers
   /// E; returns E's change (<= 0).
   double expand(CoordImage& s, const CoordImage& start, const Window& win, Coord alpha) const;
@@ -73,6 +86,7 @@ class SeamCutter {
   Coord lo_, hi_;
   CoordinateSynthesisOptions opt_;
   bool tileable_;
+  std::uint64_t seed_;
 };
 
 }  // namespace exsynth::image
