@@ -159,6 +159,9 @@ TEST(ImageSeamCut, ExpansionIsTheBestOfEveryLabellingItAllows) {
     for (double leave : {0.0, 0.3})
       for (int reach : {0, 1})
       for (std::uint64_t seed = 0; seed < 6; ++seed) {
+        // Odd seeds: a new source's footprint (2 x 2 at the window's corner) seeds the reach too.
+        const SeamCutter::Window foot{2, 1, 2, 2};
+        const bool footed = seed % 2 == 1;
         CoordinateSynthesisOptions o = cutting(1, 8, leave);
         o.cut_reach = reach;
         o.cut_radius = int(seed % 2);  // Kwatra's pair cost, and the mean over 3 x 3 around
@@ -174,6 +177,9 @@ TEST(ImageSeamCut, ExpansionIsTheBestOfEveryLabellingItAllows) {
               const Coord c{x + alpha.u, y + alpha.v};
               // With a reach: some pixel of the padded window within `reach` already continues alpha.
               bool near = reach == 0;
+              for (int yy = y - reach; yy <= y + reach && footed; ++yy)
+                for (int xx = x - reach; xx <= x + reach; ++xx)
+                  near = near || (xx >= foot.x0 && yy >= foot.y0 && xx < foot.x0 + foot.w && yy < foot.y0 + foot.h);
               for (int yy = std::max(y - reach, win.y0 - 1); yy <= std::min(y + reach, win.y0 + win.h) && !near; ++yy)
                 for (int xx = std::max(x - reach, win.x0 - 1); xx <= std::min(x + reach, win.x0 + win.w) && !near; ++xx) {
                   if (!tileable && (xx < 0 || yy < 0 || xx >= s.width || yy >= s.height)) continue;
@@ -194,7 +200,7 @@ TEST(ImageSeamCut, ExpansionIsTheBestOfEveryLabellingItAllows) {
               }
             best = std::min(best, cut.energy(t, start));
           }
-          const double delta = cut.expand(s, start, win, alpha);
+          const double delta = cut.expand(s, start, win, alpha, footed ? &foot : nullptr);
           const double after = cut.energy(s, start);
           EXPECT_LE(delta, 0.0);
           EXPECT_NEAR(after, before + delta, 1e-4);

@@ -128,9 +128,10 @@ SeamCutter::Matches SeamCutter::matches(const CoordImage& s, StageProgress& prog
   return m;
 }
 
-std::vector<Coord> SeamCutter::match_sources(const CoordImage& s, const Matches& m, const Window& win,
-                                             const std::vector<Coord>& have) const {
-  std::vector<Coord> out;
+std::vector<std::pair<Coord, SeamCutter::Window>> SeamCutter::match_sources(const CoordImage& s, const Matches& m,
+                                                                           const Window& win,
+                                                                           const std::vector<Coord>& have) const {
+  std::vector<std::pair<Coord, Window>> out;
   if (m.nn.empty()) return out;
   // A corner's position unwrapped into the window's range (tileable), or -1 when outside it.
   auto local = [&](int c, int x0, int w, int size) {
@@ -144,14 +145,16 @@ std::vector<Coord> SeamCutter::match_sources(const CoordImage& s, const Matches&
       const int x = local(m.xs[gx], win.x0, win.w, s.width);
       if (x < 0) continue;
       const Coord e = m.nn[gy * m.xs.size() + gx], off{e.u - x, e.v - y};
-      if (std::find(have.begin(), have.end(), off) == have.end() && std::find(out.begin(), out.end(), off) == out.end())
-        out.push_back(off);
+      if (std::find(have.begin(), have.end(), off) == have.end() &&
+          std::find_if(out.begin(), out.end(), [&](const auto& o) { return o.first == off; }) == out.end())
+        out.push_back({off, Window{x, y, m.n, m.n}});
     }
   }
   return out;
 }
 
-double SeamCutter::expand(CoordImage& s, const CoordImage& start, const Window& win, Coord alpha) const {
+double SeamCutter::expand(CoordImage& s, const CoordImage& start, const Window& win, Coord alpha,
+                          const Window* seed) const {
   // The padded window (one-pixel border), row-major; positions unwrapped.
   const int pw = win.w + 2, ph = win.h + 2;
   const std::size_t n = std::size_t(pw) * ph;
@@ -173,7 +176,9 @@ double SeamCutter::expand(CoordImage& s, const CoordImage& start, const Window& 
     for (int j = 0; j < ph; ++j)
       for (int i = 0; i < pw; ++i) {
         const std::size_t k = std::size_t(j) * pw + i;
-        on[k] = pix[k] >= 0 && cur[k] == Coord{win.x0 - 1 + i + alpha.u, win.y0 - 1 + j + alpha.v};
+        const int x = win.x0 - 1 + i, y = win.y0 - 1 + j;
+        on[k] = pix[k] >= 0 && (cur[k] == Coord{x + alpha.u, y + alpha.v} ||
+                                (seed && x >= seed->x0 && y >= seed->y0 && x < seed->x0 + seed->w && y < seed->y0 + seed->h));
       }
     const int r = opt_.cut_reach;
     for (int j = 0; j < ph; ++j)
@@ -285,10 +290,10 @@ void SeamCutter::run(CoordImage& s, ExecContext* ctx, double lo, double hi, std:
       // border no other window of the class writes.
       parallel_chunks(cls.size(), 1, progress, [&](std::size_t begin, std::size_t end) {
         for (std::size_t w = begin; w < end; ++w) {
-          std::vector<Coord> alphas = sources(s, cls[w]);
-          const std::vector<Coord> more = match_sources(s, m, cls[w], alphas);
-          alphas.insert(alphas.end(), more.begin(), more.end());
+          const std::vector<Coord> alphas = sources(s, cls[w]);
           for (const Coord& alpha : alphas) expand(s, start, cls[w], alpha);
+          for (const auto& [alpha, footprint] : match_sources(s, m, cls[w], alphas))
+            expand(s, start, cls[w], alpha, &footprint);
         }
       });
     }

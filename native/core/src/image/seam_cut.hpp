@@ -26,6 +26,7 @@
 // window edges. A move is kept only when it lowers E (evaluated directly),
 // so E never rises. Every output pixel stays an exemplar pixel.
 #include <cstdint>
+#include <utility>
 #include <vector>
 
 #include "exsynth/exec_context.hpp"
@@ -65,12 +66,15 @@ class SeamCutter {
   };
   Matches matches(const CoordImage& s, StageProgress& progress) const;
   /// The sources (offsets, unwrapped as the window's positions) of the
-  /// matches whose patch corners lie in `win`, not already in `have`.
-  std::vector<Coord> match_sources(const CoordImage& s, const Matches& m, const Window& win,
-                                   const std::vector<Coord>& have) const;
+  /// matches whose patch corners lie in `win`, not already in `have`, each
+  /// with its patch's footprint (the pixels it may take with cut_reach).
+  std::vector<std::pair<Coord, Window>> match_sources(const CoordImage& s, const Matches& m, const Window& win,
+                                                      const std::vector<Coord>& have) const;
   /// One expansion move of `win` by source `alpha`, kept only when it lowers
-  /// E; returns E's change (<= 0).
-  double expand(CoordImage& s, const CoordImage& start, const Window& win, Coord alpha) const;
+  /// E; returns E's change (<= 0). With cut_reach, the pixels within reach of
+  /// alpha's pixels or of `seed` (a new source's footprint) may take it.
+  double expand(CoordImage& s, const CoordImage& start, const Window& win, Coord alpha,
+                const Window* seed = nullptr) const;
 
   /// Every pass (cut_passes), progress in ctx's [lo, hi]; E after each pass appended to `energy`.
   void run(CoordImage& s, ExecContext* ctx, double lo, double hi, std::vector<double>* energy) const;
