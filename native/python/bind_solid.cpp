@@ -111,6 +111,13 @@ py::kwargs set_image_options(ImageSynthesisOptions& o, const py::kwargs& kw) {
     else if (k == "refine_stride") c.refine_stride = int_arg(v, k, 1, 32, "pixels (at most refine_patch)");
     else if (k == "refine_random") c.refine_random = int_arg(v, k, 0, 16, "probes per radius");
     else if (k == "refine_medoid") c.refine_medoid = bool_arg(v, k);
+    else if (k == "cut_passes") c.cut_passes = int_arg(v, k, 0, 16, "(0 = no seam cuts)");
+    else if (k == "cut_window") c.cut_window = int_arg(v, k, 4, 256, "pixels");
+    else if (k == "cut_labels") c.cut_labels = int_arg(v, k, 1, 256, "sources per window");
+    else if (k == "cut_reach") c.cut_reach = int_arg(v, k, 0, 256, "pixels (0 = the whole window)");
+    else if (k == "cut_radius") c.cut_radius = int_arg(v, k, 0, 4, "pixels");
+    else if (k == "cut_matches") c.cut_matches = bool_arg(v, k);
+    else if (k == "cut_leave") c.cut_leave = real_arg(v, k, 0.0, 1e6, Ends::Closed, "colour distance per pixel");
     else rest[item.first] = item.second;
   }
   return rest;
@@ -140,6 +147,10 @@ const std::string& image_doc() {
            ",\nrefine_passes=" + std::to_string(d.refine_passes) + " (the patch refinement: 0 = off), refine_patch=" +
            std::to_string(d.refine_patch) + ", refine_stride=" + std::to_string(d.refine_stride) + ", refine_random=" +
            std::to_string(d.refine_random) + ", refine_medoid=" + flag(d.refine_medoid) +
+           ",\ncut_passes=" + std::to_string(d.cut_passes) + " (the seam cuts: 0 = off), cut_window=" +
+           std::to_string(d.cut_window) + ", cut_labels=" + std::to_string(d.cut_labels) + ", cut_leave=" +
+           format_number(d.cut_leave) + ", cut_reach=" + std::to_string(d.cut_reach) + ", cut_radius=" +
+           std::to_string(d.cut_radius) + ", cut_matches=" + flag(d.cut_matches) +
            "; also tileable, max_exemplar_size, seed.\nmethod='optimization': the optimiser of synthesize_solid, "
            "same options. Returns {'image': ..., 'energy': [...]}.";
   }();
@@ -235,8 +246,9 @@ Returns {'solid': (Z, Y, X, C) float32, 'energy': [...], 'energy_level': [...]}.
         opt.height = int_arg(height, "height", 1, 16384, "pixels");
         set_common(opt, set_image_options(opt, kw),
                    "method, jitter, jitter_from, corrections, candidates_k, coherence, wide_below, "
-                   "appearance_window, appearance_dims, coarsest_spacing, exhaustive, refine_passes, refine_patch, refine_stride, refine_random, refine_medoid, tileable, max_exemplar_size, memory_budget, "
-                   "seed; with method='optimization' also synthesize_solid's (levels, neighborhood, iterations, ...)");
+                   "appearance_window, appearance_dims, coarsest_spacing, exhaustive, refine_{passes, patch, stride, random, medoid}, "
+                   "cut_{passes, window, labels, leave, reach, radius, matches}, tileable, max_exemplar_size, memory_budget, "
+                   "seed; method='optimization' also takes synthesize_solid's");
         Image img;
         std::vector<double> energy;
         {

@@ -79,7 +79,9 @@ FUNCTIONS = {
         "appearance_window": ("int", 1, 15), "appearance_dims": ("int", 1, 64),
         "coarsest_spacing": ("int", 0, 1024), "exhaustive": "bool", "refine_passes": ("int", 0, 16),
         "refine_patch": ("int", 2, 32), "refine_stride": ("int", 1, 32), "refine_random": ("int", 0, 16),
-        "refine_medoid": "bool"}),
+        "refine_medoid": "bool", "cut_passes": ("int", 0, 16), "cut_window": ("int", 4, 256),
+        "cut_labels": ("int", 1, 256), "cut_leave": ("real", 0, 1e6), "cut_reach": ("int", 0, 256),
+        "cut_radius": ("int", 0, 4), "cut_matches": "bool"}),
     "diffuse_direction_field": (call("diffuse_direction_field", VERTS, FACES, GIVEN), {
         "weights": "str", "seed": "seed", "ctx": "ctx"}),
     "preset_direction_field": (call("preset_direction_field", VERTS, FACES), {"preset": "str", "ctx": "ctx"}),

@@ -230,6 +230,27 @@ struct CoordinateSynthesisOptions {
   /// their mean colour (false: less copying, lower nn_rel, but it favours
   /// mid-tones: lower sharpness; docs/solid.md).
   bool refine_medoid = true;
+  /// Seam cuts after the finest level and the refinement (cut_passes
+  /// sweeps, 0 = none; image/seam_cut.hpp): graph-cut expansion moves on
+  /// cut_window^2 windows move the seams between coherent regions to where
+  /// the two sources agree (Kwatra et al. 2003's seam cost), alpha over the
+  /// cut_labels commonest sources of each window; cut_leave is the cost (in
+  /// colour distance, the exemplar's units) a pixel pays for leaving the
+  /// synthesis's coordinate, which holds the regions' growth (copying) back.
+  int cut_passes = 0;
+  int cut_window = 32;
+  int cut_labels = 16;
+  double cut_leave = 0.0;
+  /// A move by source alpha reaches only pixels within cut_reach (Chebyshev)
+  /// of alpha's pixels (0 = the whole window).
+  int cut_reach = 4;
+  /// The seam cost compares the two sources over (2 cut_radius + 1)^2
+  /// pixels around each of the pair (the mean; 0 = the pair only, Kwatra's).
+  int cut_radius = 0;
+  /// Also try as alpha, in each window, the sources of the nearest exemplar
+  /// patches (PatchMatch of the refinement: refine_patch, refine_stride,
+  /// refine_random) of the output patches whose corners lie in the window.
+  bool cut_matches = false;
 };
 
 struct ImageSynthesisOptions : TextureOptimizationOptions {

@@ -12,6 +12,7 @@
 #include "exsynth/pyramid.hpp"
 #include "exsynth/rng.hpp"
 #include "image/patch_refinement.hpp"
+#include "image/seam_cut.hpp"
 #include "search/kd_tree.hpp"
 
 namespace exsynth::image {
@@ -82,6 +83,20 @@ void check_coordinate_options(const CoordinateSynthesisOptions& o) {
   if (o.refine_random < 0 || o.refine_random > 16)
     throw InvalidInput("refine_random must be between 0 and 16 probes per radius, got " +
                        std::to_string(o.refine_random));
+  if (o.cut_passes < 0 || o.cut_passes > 16)
+    throw InvalidInput("cut_passes must be between 0 and 16 (0 = no seam cuts), got " + std::to_string(o.cut_passes));
+  if (o.cut_window < 4 || o.cut_window > 256)
+    throw InvalidInput("cut_window must be between 4 and 256 pixels, got " + std::to_string(o.cut_window));
+  if (o.cut_labels < 1 || o.cut_labels > 256)
+    throw InvalidInput("cut_labels must be between 1 and 256 sources per window, got " + std::to_string(o.cut_labels));
+  if (!(o.cut_leave >= 0 && o.cut_leave <= 1e6))
+    throw InvalidInput("cut_leave must be between 0 and 1e6 (colour distance per pixel), got " +
+                       std::to_string(o.cut_leave));
+  if (o.cut_reach < 0 || o.cut_reach > 256)
+    throw InvalidInput("cut_reach must be between 0 and 256 pixels (0 = the whole window), got " +
+                       std::to_string(o.cut_reach));
+  if (o.cut_radius < 0 || o.cut_radius > 4)
+    throw InvalidInput("cut_radius must be between 0 and 4 pixels, got " + std::to_string(o.cut_radius));
   if (o.coarsest_spacing != 0 && (!pow2(o.coarsest_spacing) || o.coarsest_spacing > 1024))
     throw InvalidInput("coarsest_spacing must be 0 (automatic) or a power of two from 1 to 1024, got " +
                        std::to_string(o.coarsest_spacing));
@@ -414,8 +429,9 @@ CoordImage CoordinateSolver::synthesize(int width, int height, ExecContext* ctx,
   for (std::size_t l = 0; l < L; ++l) remaining += double(ws[l]) * hs[l];
   const int passes = std::max(opt_.corrections, 0);
   CoordImage s;
-  // The patch refinement's share of the progress: about what it costs.
-  const double levels_hi = opt_.refine_passes > 0 ? lo + 0.6 * (hi - lo) : hi;
+  // The patch refinement's and the seam cuts' shares of the progress: about what they cost.
+  const double cut_lo = opt_.cut_passes > 0 ? lo + 0.6 * (hi - lo) : hi;
+  const double levels_hi = opt_.refine_passes > 0 ? lo + 0.6 * (cut_lo - lo) : cut_lo;
   double at = lo;
   for (std::size_t l = 0; l < L; ++l) {
     const double pixels = double(ws[l]) * hs[l];
@@ -435,7 +451,8 @@ CoordImage CoordinateSolver::synthesize(int width, int height, ExecContext* ctx,
     }
     at = next;
   }
-  PatchRefiner(scaled_, lowest(), highest(), opt_, tileable_, seed_).run(s, ctx, levels_hi, hi, energy);
+  PatchRefiner(scaled_, lowest(), highest(), opt_, tileable_, seed_).run(s, ctx, levels_hi, cut_lo, energy);
+  SeamCutter(scaled_, lowest(), highest(), opt_, tileable_, seed_).run(s, ctx, cut_lo, hi, energy);
   return s;
 }
 
@@ -474,12 +491,13 @@ Image synthesize_coordinates(const Image& exemplar, const ImageSynthesisOptions&
     // Peak: the index's windows (n^2 C floats per pixel) and coefficients,
     // the appearance stack (8 floats per pixel per level, ~log2(edge)
     // levels), and per output pixel two coordinate images and the colours
-    // (the patch refinement: one more coordinate image and gathered colours).
+    // (the patch refinement: one more coordinate image and gathered colours;
+    // the seam cuts: the synthesis's coordinates kept, and the matches).
     const double n = opt.coordinates.appearance_window, px = double(ex->pixel_count());
     const double levels = std::log2(std::max(2, std::min(ex->width(), ex->height()))) + 1;
     const double bytes = 4.0 * px * (n * n * ex->channels() + 8.0 * (levels + 2)) +
                          double(opt.width) * opt.height * (16.0 + 4.0 * ex->channels()) *
-                             (opt.coordinates.refine_passes > 0 ? 2.0 : 1.0);
+                             (opt.coordinates.refine_passes > 0 || opt.coordinates.cut_passes > 0 ? 2.0 : 1.0);
     check_memory_budget(bytes, opt.memory_budget,
                         "image synthesis of " + std::to_string(opt.width) + "x" + std::to_string(opt.height) +
                             " from a " + std::to_string(ex->width()) + "x" + std::to_string(ex->height()) +
