@@ -19,6 +19,7 @@ left half: an unseen piece of the same texture is the score a synthesis that
 does not copy can hope for.
 
 usage: bench_quality.py --build BUILD_DIR [--full] [--exemplars a,b] [--no-peers] [--no-calibration]
+                       [--options 'k=v, ...'] [--image-options 'k=v, ...']
 """
 import argparse
 import os
@@ -138,6 +139,8 @@ def main(argv=None):
     ap.add_argument("--no-peers", action="store_true")
     ap.add_argument("--solids-only", action="store_true", help="only the solids (no images, peers or speed)")
     ap.add_argument("--options", default="", help="extra engine options, e.g. 'coherent_upsampling=False'")
+    ap.add_argument("--image-options", default="",
+                    help="extra options for synthesize_image only, e.g. 'cut_passes=2' (synthesize_solid rejects them)")
     ap.add_argument("--no-calibration", action="store_true", help="skip the held-out-half calibration of nn_rel")
     args = ap.parse_args(argv)
     sys.path.insert(0, os.path.join(args.build, "addon"))
@@ -149,7 +152,9 @@ def main(argv=None):
     tmp = tempfile.mkdtemp(prefix="exsynth_bench_")
     method = opts.get("method", _native.SOLID_DEFAULT_METHOD)
     image_opts = {k: v for k, v in opts.items() if k not in SOLID_ONLY}
-    print(f"machine: {os.cpu_count()} cores; 128^2 exemplars, {args.options or 'default options'}, seed 7; "
+    image_opts.update(eval(f"dict({args.image_options})", {}))  # noqa: S307 - a developer's command line
+    print(f"machine: {os.cpu_count()} cores; 128^2 exemplars, {args.options or 'default options'}"
+          f"{'; images also ' + args.image_options if args.image_options else ''}, seed 7; "
           f"solids: mean of x/y/z slices, method {method}")
     print(f"image method: {opts.get('method', _native.IMAGE_DEFAULT_METHOD)} (synthesize_image's default: {_native.IMAGE_DEFAULT_METHOD}); "
           f"load average at start {os.getloadavg()[0]:.1f}")
