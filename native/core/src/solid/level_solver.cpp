@@ -173,7 +173,12 @@ double LevelSolver::search(int iteration, bool exhaustive, StageProgress& progre
         // coefficients while the previous query is scored.
         for (int c : cand) __builtin_prefetch(ex.coefficients().row(c).data());
       };
-      std::vector<int> cand_of[2];
+      // Candidates are generated kAhead queries before they are scored, so
+      // their prefetched coefficients have arrived (one query ahead, the
+      // first coefficient load was a third of the scoring's time in perf).
+      constexpr std::size_t kAhead = 2;
+      std::vector<int> cand_of[kAhead + 1];
+      std::vector<int> best_of(batch);
       for (std::size_t b = b0; b < b1; ++b) {
         const std::size_t first = b * batch, rows = std::min(batch, w.size() - first);
         for (std::size_t k = 0; k < rows; ++k) order[k] = sparse_of(first + k);
@@ -181,7 +186,8 @@ double LevelSolver::search(int iteration, bool exhaustive, StageProgress& progre
         RowMatrixXf y;
         if (opt_.search != SolidSearch::Exact) y = ex.pca().project(x.topRows(Eigen::Index(rows)));
         const bool coherence = opt_.search == SolidSearch::KCoherence && !exhaustive;
-        if (coherence) candidates(order[0], cand_of[0]);
+        if (coherence)
+          for (std::size_t k = 0; k < std::min(kAhead, rows); ++k) candidates(order[k], cand_of[k % (kAhead + 1)]);
         for (std::size_t k = 0; k < rows; ++k) {
           const std::size_t sp = order[k];
           int best = -1;
@@ -198,8 +204,8 @@ double LevelSolver::search(int iteration, bool exhaustive, StageProgress& progre
           } else {
             // The next query's candidates first (their loads overlap this
             // query's scoring; reads only the previous round's matches).
-            if (k + 1 < rows) candidates(order[k + 1], cand_of[(k + 1) & 1]);
-            const std::vector<int>& cand = cand_of[k & 1];
+            if (k + kAhead < rows) candidates(order[k + kAhead], cand_of[(k + kAhead) % (kAhead + 1)]);
+            const std::vector<int>& cand = cand_of[k % (kAhead + 1)];
             // Partial distances over 8-float blocks (the PCA space is padded
             // to a multiple of 8): most candidates lose within the first,
             // highest-variance dimensions, so stop as soon as they do.
@@ -218,7 +224,22 @@ double LevelSolver::search(int iteration, bool exhaustive, StageProgress& progre
             if (best < 0) best = cand.front();  // every distance non-finite: never index with -1
           }
           next[sp] = best;
-          const float d2 = (ex.neighbourhoods().row(best) - x.row(Eigen::Index(k))).squaredNorm();
+          best_of[k] = best;
+        }
+        // The matches' full-dimension distances, in a pass of their own: each
+        // reads a scattered D-float exemplar row, requested kRowAhead matches
+        // before (inline after the scoring, its first load stalled: perf).
+        constexpr std::size_t kRowAhead = 2;
+        const std::size_t row_bytes = std::size_t(D) * sizeof(float);
+        auto prefetch_row = [&](std::size_t k) {
+          const char* p = reinterpret_cast<const char*>(ex.neighbourhoods().row(best_of[k]).data());
+          for (std::size_t o = 0; o < row_bytes; o += 64) __builtin_prefetch(p + o);
+        };
+        for (std::size_t k = 0; k < std::min(kRowAhead, rows); ++k) prefetch_row(k);
+        for (std::size_t k = 0; k < rows; ++k) {
+          if (k + kRowAhead < rows) prefetch_row(k + kRowAhead);
+          const std::size_t sp = order[k];
+          const float d2 = (ex.neighbourhoods().row(best_of[k]) - x.row(Eigen::Index(k))).squaredNorm();
           energy[sp] = std::pow(d2, 0.5f * r);
           // IRLS for the |.|^r energy; the floor keeps exact matches finite.
           w.weight[sp] = std::pow(std::max(d2, 1e-6f), 0.5f * (r - 2.0f));
@@ -261,24 +282,29 @@ std::vector<std::int64_t> LevelSolver::solid_histogram() const {
 // (all 1 without histogram matching). The excess sums over channels, so many
 // channels would multiply the re-weighting: the exponent is as measured on RGB
 // for up to 3 channels and scaled by 3 / C above (6 channels: half).
+// Writes the factors into slot 0 of tables.texel's pixels (the texels follow).
 void LevelSolver::histogram_factors(const std::vector<std::int64_t>& counts, const std::vector<double>& target,
-                                    std::array<std::vector<float>, 3>& factor) const {
+                                    OptimizeTables& tables) const {
   const int bins = opt_.histogram_bins;
   const double strength = C_ <= 3 || opt_.histogram_strength == 1.0 ? opt_.histogram_strength : opt_.histogram_strength * 3.0 / C_;
   const double total = double(tex_.voxel_count());
+  const std::size_t stride = std::size_t(C_) + 1;
   for (int i = 0; i < 3; ++i) {
     const View& w = views_[i];
     if (!w.ex) continue;
     const Image& img = w.ex->image();
-    factor[i].assign(img.pixel_count(), 1.0f);
-    if (!opt_.histogram_matching) continue;
+    float* texel = tables.texel[i].data();
+    if (!opt_.histogram_matching) {
+      for (std::size_t p = 0; p < img.pixel_count(); ++p) texel[p * stride] = 1.0f;
+      continue;
+    }
     for (std::size_t p = 0; p < img.pixel_count(); ++p) {
       double excess = 0.0;
       for (int c = 0; c < C_; ++c) {
         const std::size_t k = std::size_t(c) * bins + w.ex->bin(p, c);
         excess += std::max(0.0, counts[k] * bins / total - target[k]);
       }
-      factor[i][p] = float(strength == 1.0 ? 1.0 / (1.0 + excess) : std::pow(1.0 + excess, -strength));
+      texel[p * stride] = float(strength == 1.0 ? 1.0 / (1.0 + excess) : std::pow(1.0 + excess, -strength));
     }
   }
 }
@@ -327,18 +353,19 @@ bool LevelSolver::blend_voxel(const int p[3], const OptimizeTables& tables, Voxe
     const Image& img = w.ex->image();
     const Covering cov = cover(p, s);
     const std::size_t slice = std::size_t(p[s.axis]) * w.nv;
-    const std::int32_t* corner = tables.window_corner[i].data();
-    const float* fac = tables.factor[i].data();
+    const SparseWindow* window = tables.window[i].data();
+    const float* texel = tables.texel[i].data();
+    const std::size_t stride = std::size_t(C_) + 1;
     for (int a = 0; a < cov.nv; ++a) {
       const std::size_t row = (slice + cov.sv[a]) * w.nu;
       const std::size_t pix_dv = std::size_t(cov.dv[a]) * img.width();
       for (int b = 0; b < cov.nu; ++b) {
-        const std::size_t sp = row + cov.su[b];
-        const int j = w.match[sp];
-        if (j < 0) continue;
-        const std::size_t pix = std::size_t(corner[j]) + pix_dv + cov.du[b];
-        const float wt = w.weight[sp] * fac[pix];
-        const float* e = img.data() + pix * C_;
+        const SparseWindow& sw = window[row + cov.su[b]];
+        if (sw.corner < 0) continue;
+        const std::size_t pix = std::size_t(sw.corner) + pix_dv + cov.du[b];
+        const float* t = texel + pix * stride;
+        const float wt = sw.weight * t[0];
+        const float* e = t + 1;
         for (int c = 0; c < C_; ++c) scratch.acc[c] += wt * e[c];
         wsum += wt;
         if (opt_.mean_shift) {
@@ -375,20 +402,28 @@ void LevelSolver::optimize(int iteration, StageProgress& progress) {
   for (std::size_t k = blocks; k > 1; --k) std::swap(order[k - 1], order[shuffle.below(k)]);
   const std::size_t groups = std::min<std::size_t>(blocks, 16);
 
-  // window_corner[i][j] = pixel index of window j's top-left texel in view
-  // i's exemplar.
+  // The blend's tables (see OptimizeTables): per sparse voxel its window's
+  // top-left texel and weight; per exemplar pixel its values (the factor
+  // slot is written per group by histogram_factors).
   OptimizeTables tables;
+  const std::size_t stride = std::size_t(C_) + 1;
   for (int i = 0; i < 3; ++i) {
     const View& w = views_[i];
     if (!w.ex) continue;
-    tables.window_corner[i].resize(w.ex->count());
-    for (int j = 0; j < w.ex->count(); ++j)
-      tables.window_corner[i][j] = (w.ex->centre_v(j) - lo_) * w.ex->image().width() + (w.ex->centre_u(j) - lo_);
+    const Image& img = w.ex->image();
+    tables.window[i].resize(w.size());
+    for (std::size_t sp = 0; sp < w.size(); ++sp) {
+      const int j = w.match[sp];
+      tables.window[i][sp] = {j < 0 ? -1 : (w.ex->centre_v(j) - lo_) * img.width() + (w.ex->centre_u(j) - lo_), w.weight[sp]};
+    }
+    tables.texel[i].assign(img.pixel_count() * stride, 1.0f);
+    for (std::size_t p = 0; p < img.pixel_count(); ++p)
+      std::copy(img.data() + p * C_, img.data() + (p + 1) * C_, tables.texel[i].data() + p * stride + 1);
   }
 
   std::vector<std::vector<std::int64_t>> deltas;
   for (std::size_t g = 0; g < groups; ++g) {
-    histogram_factors(counts, target, tables.factor);
+    histogram_factors(counts, target, tables);
     const std::size_t g0 = g * blocks / groups, g1 = (g + 1) * blocks / groups;
     deltas.assign(g1 - g0, {});
     parallel_chunks(g1 - g0, 1, progress, [&](std::size_t k0, std::size_t k1) {
