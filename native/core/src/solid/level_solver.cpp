@@ -79,6 +79,16 @@ void LevelSolver::gather(int i, std::size_t sparse, float* row) const {
   const int* wu = wrapped_[s.u].data() + n_ + p[s.u] - lo_;
   const int* wv = wrapped_[s.v].data() + n_ + p[s.v] - lo_;
   const float* base = tex_.data() + std::size_t(p[s.axis]) * stride[s.axis] * C_;
+  if (C_ == 3) {  // RGB: three moves per texel (the loop below became a memmove call per texel: perf)
+    for (int dv = 0; dv < n_; ++dv) {
+      const float* line = base + std::size_t(wv[dv]) * stride[s.v] * 3;
+      for (int du = 0; du < n_; ++du, row += 3) {
+        const float* src = line + std::size_t(wu[du]) * stride[s.u] * 3;
+        row[0] = src[0], row[1] = src[1], row[2] = src[2];
+      }
+    }
+    return;
+  }
   for (int dv = 0; dv < n_; ++dv) {
     const float* line = base + std::size_t(wv[dv]) * stride[s.v] * C_;
     for (int du = 0; du < n_; ++du) {
@@ -289,11 +299,10 @@ void LevelSolver::histogram_factors(const std::vector<std::int64_t>& counts, con
   const double strength = C_ <= 3 || opt_.histogram_strength == 1.0 ? opt_.histogram_strength : opt_.histogram_strength * 3.0 / C_;
   const double total = double(tex_.voxel_count());
   const std::size_t stride = std::size_t(C_) + 1;
-  for (int i = 0; i < 3; ++i) {
-    const View& w = views_[i];
-    if (!w.ex) continue;
-    const Image& img = w.ex->image();
-    float* texel = tables.texel[i].data();
+  for (std::size_t e = 0; e < tables.texel.size(); ++e) {
+    const ExemplarIndex& ex = *tables.texel_ex[e];
+    const Image& img = ex.image();
+    float* texel = tables.texel[e].data();
     if (!opt_.histogram_matching) {
       for (std::size_t p = 0; p < img.pixel_count(); ++p) texel[p * stride] = 1.0f;
       continue;
@@ -301,7 +310,7 @@ void LevelSolver::histogram_factors(const std::vector<std::int64_t>& counts, con
     for (std::size_t p = 0; p < img.pixel_count(); ++p) {
       double excess = 0.0;
       for (int c = 0; c < C_; ++c) {
-        const std::size_t k = std::size_t(c) * bins + w.ex->bin(p, c);
+        const std::size_t k = std::size_t(c) * bins + ex.bin(p, c);
         excess += std::max(0.0, counts[k] * bins / total - target[k]);
       }
       texel[p * stride] = float(strength == 1.0 ? 1.0 / (1.0 + excess) : std::pow(1.0 + excess, -strength));
@@ -354,7 +363,7 @@ bool LevelSolver::blend_voxel(const int p[3], const OptimizeTables& tables, Voxe
     const Covering cov = cover(p, s);
     const std::size_t slice = std::size_t(p[s.axis]) * w.nv;
     const SparseWindow* window = tables.window[i].data();
-    const float* texel = tables.texel[i].data();
+    const float* texel = tables.texel[std::size_t(tables.texel_of[i])].data();
     const std::size_t stride = std::size_t(C_) + 1;
     for (int a = 0; a < cov.nv; ++a) {
       const std::size_t row = (slice + cov.sv[a]) * w.nu;
@@ -416,9 +425,13 @@ void LevelSolver::optimize(int iteration, StageProgress& progress) {
       const int j = w.match[sp];
       tables.window[i][sp] = {j < 0 ? -1 : (w.ex->centre_v(j) - lo_) * img.width() + (w.ex->centre_u(j) - lo_), w.weight[sp]};
     }
-    tables.texel[i].assign(img.pixel_count() * stride, 1.0f);
+    const auto shared = std::find(tables.texel_ex.begin(), tables.texel_ex.end(), w.ex);
+    tables.texel_of[i] = int(shared - tables.texel_ex.begin());
+    if (shared != tables.texel_ex.end()) continue;
+    tables.texel_ex.push_back(w.ex);
+    std::vector<float>& texel = tables.texel.emplace_back(img.pixel_count() * stride, 1.0f);
     for (std::size_t p = 0; p < img.pixel_count(); ++p)
-      std::copy(img.data() + p * C_, img.data() + (p + 1) * C_, tables.texel[i].data() + p * stride + 1);
+      std::copy(img.data() + p * C_, img.data() + (p + 1) * C_, texel.data() + p * stride + 1);
   }
 
   std::vector<std::vector<std::int64_t>> deltas;

@@ -73,9 +73,13 @@ class LevelSolver {
     std::int32_t corner;
     float weight;
   };
+  // Views that share an exemplar share its texel table (one 256 KiB table
+  // for a 128^2 RGB exemplar fits the L2 cache; three did not: perf).
   struct OptimizeTables {
     std::array<std::vector<SparseWindow>, 3> window;  // per view: per sparse voxel
-    std::array<std::vector<float>, 3> texel;          // per view: per exemplar pixel, factor then C values
+    std::vector<std::vector<float>> texel;            // per distinct exemplar: per pixel, factor then C values
+    std::vector<const ExemplarIndex*> texel_ex;       // the exemplar of each texel table
+    std::array<int, 3> texel_of{-1, -1, -1};          // per view: its texel table
   };
   struct VoxelScratch {
     std::vector<float> acc, mode;      // C floats each: the voxel's value, mean-shift scratch
