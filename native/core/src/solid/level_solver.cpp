@@ -52,7 +52,28 @@ LevelSolver::LevelSolver(Volume& texture, std::array<const ExemplarIndex*, 3> vi
     w.match.assign(w.size(), -1);
     w.weight.assign(w.size(), 1.0f);
     if (opt_.search == SolidSearch::KdTree) w.kd = std::make_unique<search::KdTree>(w.ex->coefficients());
+    if (opt_.search == SolidSearch::KCoherence) {
+      auto it = std::find_if(blocked_.begin(), blocked_.end(), [&](const BlockedCoefficients& b) { return b.ex == w.ex; });
+      w.blocked = int(it - blocked_.begin());
+      if (it == blocked_.end()) blocked_.push_back(blocked_coefficients(*w.ex));
+    }
   }
+}
+
+LevelSolver::BlockedCoefficients LevelSolver::blocked_coefficients(const ExemplarIndex& ex) {
+  const RowMatrixXf& rows = ex.coefficients();  // columns padded to a multiple of 8 (ExemplarIndex)
+  BlockedCoefficients b;
+  b.ex = &ex;
+  b.count = std::size_t(rows.rows());
+  const std::size_t blocks = std::size_t(rows.cols()) / 8;
+  b.storage.resize(blocks * b.count * 8 + 16);
+  const std::uintptr_t addr = reinterpret_cast<std::uintptr_t>(b.storage.data());
+  float* base = b.storage.data() + ((64 - addr % 64) % 64) / sizeof(float);
+  b.base = base;
+  for (std::size_t t = 0; t < blocks; ++t)
+    for (std::size_t j = 0; j < b.count; ++j)
+      std::copy_n(rows.row(Eigen::Index(j)).data() + t * 8, 8, base + (t * b.count + j) * 8);
+  return b;
 }
 
 LevelSolver::~LevelSolver() = default;
@@ -125,6 +146,8 @@ double LevelSolver::search(int iteration, bool exhaustive, StageProgress& progre
     View& w = views_[i];
     if (!w.ex) continue;
     const ExemplarIndex& ex = *w.ex;
+    static const BlockedCoefficients kNone;
+    const BlockedCoefficients& blocked = w.blocked >= 0 ? blocked_[std::size_t(w.blocked)] : kNone;
     // Matches are read from the previous round and written to a new one, so
     // the result does not depend on the order chunks run in.
     std::vector<std::int32_t> next(w.size());
@@ -181,7 +204,7 @@ double LevelSolver::search(int iteration, bool exhaustive, StageProgress& progre
         for (int q = 0; q < opt_.random_candidates || cand.empty(); ++q) cand.push_back(int(rng.below(ex.count())));
         // Candidates sit at scattered exemplar positions: request their first
         // coefficients while the previous query is scored.
-        for (int c : cand) __builtin_prefetch(ex.coefficients().row(c).data());
+        for (int c : cand) __builtin_prefetch(blocked.block(0, c));
       };
       // Candidates are generated kAhead queries before they are scored, so
       // their prefetched coefficients have arrived (one query ahead, the
@@ -224,11 +247,10 @@ double LevelSolver::search(int iteration, bool exhaustive, StageProgress& progre
             const int d = int(y.cols());
             const float* q = y.row(Eigen::Index(k)).data();
             for (int c : cand) {
-              const float* e = ex.coefficients().row(c).data();
               float acc = 0.0f;
               int t = 0;
               for (; t < d && acc < bd; t += 8)
-                acc += (Eigen::Map<const Block>(e + t) - Eigen::Map<const Block>(q + t)).squaredNorm();
+                acc += (Eigen::Map<const Block>(blocked.block(t / 8, c)) - Eigen::Map<const Block>(q + t)).squaredNorm();
               if (t >= d && acc < bd) bd = acc, best = c;
             }
             if (best < 0) best = cand.front();  // every distance non-finite: never index with -1
