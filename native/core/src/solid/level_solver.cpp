@@ -212,6 +212,7 @@ double LevelSolver::search(int iteration, bool exhaustive, StageProgress& progre
       constexpr std::size_t kAhead = 2;
       std::vector<int> cand_of[kAhead + 1];
       std::vector<int> best_of(batch);
+      std::vector<float> first_block;
       for (std::size_t b = b0; b < b1; ++b) {
         const std::size_t first = b * batch, rows = std::min(batch, w.size() - first);
         for (std::size_t k = 0; k < rows; ++k) order[k] = sparse_of(first + k);
@@ -246,9 +247,20 @@ double LevelSolver::search(int iteration, bool exhaustive, StageProgress& progre
             float bd = std::numeric_limits<float>::max();
             const int d = int(y.cols());
             const float* q = y.row(Eigen::Index(k)).data();
-            for (int c : cand) {
+            // The first block of every candidate in a branch-free pass of
+            // its own, so their loads overlap (the early exit's unpredictable
+            // branches serialised them); then the early-exit scan exactly as
+            // if the first block were summed inline (same sums, same order,
+            // same ties: the first candidate of the least distance wins).
+            first_block.resize(cand.size());
+            const Eigen::Map<const Block> q0(q);
+            for (std::size_t m = 0; m < cand.size(); ++m)
+              first_block[m] = (Eigen::Map<const Block>(blocked.block(0, cand[m])) - q0).squaredNorm();
+            for (std::size_t m = 0; m < cand.size(); ++m) {
+              const int c = cand[m];
               float acc = 0.0f;
               int t = 0;
+              if (acc < bd) acc += first_block[m], t = 8;
               for (; t < d && acc < bd; t += 8)
                 acc += (Eigen::Map<const Block>(blocked.block(t / 8, c)) - Eigen::Map<const Block>(q + t)).squaredNorm();
               if (t >= d && acc < bd) bd = acc, best = c;
