@@ -73,6 +73,8 @@ LevelSolver::BlockedCoefficients LevelSolver::blocked_coefficients(const Exempla
   for (std::size_t t = 0; t < blocks; ++t)
     for (std::size_t j = 0; j < b.count; ++j)
       std::copy_n(rows.row(Eigen::Index(j)).data() + t * 8, 8, base + (t * b.count + j) * 8);
+  b.centre.resize(b.count);
+  for (std::size_t j = 0; j < b.count; ++j) b.centre[j] = {ex.centre_u(int(j)), ex.centre_v(int(j))};
   return b;
 }
 
@@ -167,50 +169,61 @@ double LevelSolver::search(int iteration, bool exhaustive, StageProgress& progre
       RowMatrixXf x(batch, D);
       std::vector<std::size_t> order(batch);
       // stamp[j] = the last query that proposed candidate j: O(1) dedupe.
-      // Coherent neighbours mostly propose the same candidates.
-      std::vector<std::uint32_t> stamp(opt_.search == SolidSearch::KCoherence ? ex.count() : 0, 0);
+      // Coherent neighbours mostly propose the same candidates. The last
+      // slot is a sink for shifts that leave the exemplar: it always holds
+      // the current query, so they are never taken.
+      const bool coherent_search = opt_.search == SolidSearch::KCoherence;
+      const int sink = ex.count();
+      std::vector<std::uint32_t> stamp(coherent_search ? std::size_t(ex.count()) + 1 : 0, 0);
       std::uint32_t query = 0;
+      const int k_sim = ex.coherence_k();
+      const std::size_t max_candidates = 9 * std::size_t(k_sim + 1) + std::size_t(std::max(opt_.random_candidates, 1));
       // k-coherence: each sparse neighbour's match, shifted to this voxel,
       // and that match's k most similar neighbourhoods, shifted likewise;
-      // plus a few random ones to escape local minima.
-      auto candidates = [&](std::size_t sp, std::vector<int>& cand) {
-        cand.clear();
+      // plus a few random ones to escape local minima. Branch-free appends
+      // (the dedupe's branch was unpredictable; perf) in the same order.
+      auto candidates = [&](std::size_t sp, Candidates& out) {
+        out.idx.resize(max_candidates);
+        int* cand = out.idx.data();
+        std::size_t n = 0;
         ++query;  // stamps start at 0, queries at 1
+        if (coherent_search) stamp[std::size_t(sink)] = query;
         const int a = int(sp / (std::size_t(w.nu) * w.nv)), sv = int((sp / w.nu) % w.nv), su = int(sp % w.nu);
         for (int dv = -1; dv <= 1; ++dv)
           for (int du = -1; du <= 1; ++du) {
             int nu = su + du, nv = sv + dv;
-            if (wrap_) {
-              nu = (nu + w.nu) % w.nu;
-              nv = (nv + w.nv) % w.nv;
+            if (wrap_) {  // |du|, |dv| <= 1: one step wraps (no division)
+              nu = nu < 0 ? nu + w.nu : (nu >= w.nu ? nu - w.nu : nu);
+              nv = nv < 0 ? nv + w.nv : (nv >= w.nv ? nv - w.nv : nv);
             } else if (nu < 0 || nv < 0 || nu >= w.nu || nv >= w.nv) {
               continue;
             }
             const int j = w.match[(std::size_t(a) * w.nv + nv) * w.nu + nu];
             if (j < 0) continue;
             auto add_shifted = [&](int jj) {
-              if (jj < 0) return;
-              const int c = ex.index_of(ex.centre_u(jj) - 2 * du, ex.centre_v(jj) - 2 * dv);
-              if (c >= 0 && stamp[c] != query) {
-                stamp[c] = query;
-                cand.push_back(c);
-              }
+              const Centre cc = blocked.centre[std::size_t(jj < 0 ? 0 : jj)];
+              const int c = jj < 0 ? -1 : ex.index_of(cc.u - 2 * du, cc.v - 2 * dv);
+              const std::size_t slot = std::size_t(c < 0 ? sink : c);
+              cand[n] = c;
+              n += stamp[slot] != query;
+              stamp[slot] = query;
             };
             add_shifted(j);
             const std::int32_t* sim = ex.similar(j);
-            for (int q = 0; q < ex.coherence_k(); ++q) add_shifted(sim[q]);
+            for (int q = 0; q < k_sim; ++q) add_shifted(sim[q]);
           }
         IndexRng rng(seed_, sp, std::uint64_t(iteration) * 3 + i);
-        for (int q = 0; q < opt_.random_candidates || cand.empty(); ++q) cand.push_back(int(rng.below(ex.count())));
+        for (int q = 0; q < opt_.random_candidates || n == 0; ++q) cand[n++] = int(rng.below(ex.count()));
+        out.n = n;
         // Candidates sit at scattered exemplar positions: request their first
-        // coefficients while the previous query is scored.
-        for (int c : cand) __builtin_prefetch(blocked.block(0, c));
+        // coefficients while the previous queries are scored.
+        for (std::size_t m = 0; m < n; ++m) __builtin_prefetch(blocked.block(0, cand[m]));
       };
       // Candidates are generated kAhead queries before they are scored, so
       // their prefetched coefficients have arrived (one query ahead, the
       // first coefficient load was a third of the scoring's time in perf).
       constexpr std::size_t kAhead = 2;
-      std::vector<int> cand_of[kAhead + 1];
+      Candidates cand_of[kAhead + 1];
       std::vector<int> best_of(batch);
       std::vector<float> first_block;
       for (std::size_t b = b0; b < b1; ++b) {
@@ -239,7 +252,9 @@ double LevelSolver::search(int iteration, bool exhaustive, StageProgress& progre
             // The next query's candidates first (their loads overlap this
             // query's scoring; reads only the previous round's matches).
             if (k + kAhead < rows) candidates(order[k + kAhead], cand_of[(k + kAhead) % (kAhead + 1)]);
-            const std::vector<int>& cand = cand_of[k % (kAhead + 1)];
+            const Candidates& cand_list = cand_of[k % (kAhead + 1)];
+            const int* cand = cand_list.idx.data();
+            const std::size_t cand_count = cand_list.n;
             // Partial distances over 8-float blocks (the PCA space is padded
             // to a multiple of 8): most candidates lose within the first,
             // highest-variance dimensions, so stop as soon as they do.
@@ -252,11 +267,11 @@ double LevelSolver::search(int iteration, bool exhaustive, StageProgress& progre
             // branches serialised them); then the early-exit scan exactly as
             // if the first block were summed inline (same sums, same order,
             // same ties: the first candidate of the least distance wins).
-            first_block.resize(cand.size());
+            first_block.resize(cand_count);
             const Eigen::Map<const Block> q0(q);
-            for (std::size_t m = 0; m < cand.size(); ++m)
+            for (std::size_t m = 0; m < cand_count; ++m)
               first_block[m] = (Eigen::Map<const Block>(blocked.block(0, cand[m])) - q0).squaredNorm();
-            for (std::size_t m = 0; m < cand.size(); ++m) {
+            for (std::size_t m = 0; m < cand_count; ++m) {
               const int c = cand[m];
               float acc = 0.0f;
               int t = 0;
@@ -265,7 +280,7 @@ double LevelSolver::search(int iteration, bool exhaustive, StageProgress& progre
                 acc += (Eigen::Map<const Block>(blocked.block(t / 8, c)) - Eigen::Map<const Block>(q + t)).squaredNorm();
               if (t >= d && acc < bd) bd = acc, best = c;
             }
-            if (best < 0) best = cand.front();  // every distance non-finite: never index with -1
+            if (best < 0) best = cand[0];  // every distance non-finite: never index with -1
           }
           next[sp] = best;
           best_of[k] = best;

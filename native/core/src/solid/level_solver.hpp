@@ -129,14 +129,22 @@ class LevelSolver {
   // and the first blocks of all windows (121^2 x 32 B = 458 KiB at 128^2) fit
   // the L2 cache where the row-major rows (1.8 MiB at 32 dimensions) did not:
   // the first load of each candidate was ~40 % of the scoring's time (perf).
+  struct Centre {
+    std::int32_t u, v;  // one load where ExemplarIndex's two tables took two
+  };
   struct BlockedCoefficients {
     const ExemplarIndex* ex = nullptr;
+    std::vector<Centre> centre;  // per window
     std::vector<float> storage;
     const float* base = nullptr;
     std::size_t count = 0;
     const float* block(int t, int j) const { return base + (std::size_t(t) * count + std::size_t(j)) * 8; }
   };
   std::vector<BlockedCoefficients> blocked_;
+  struct Candidates {
+    std::vector<int> idx;  // capacity for the most a query proposes; the first n are its candidates
+    std::size_t n = 0;
+  };
 };
 
 }  // namespace exsynth::solid
