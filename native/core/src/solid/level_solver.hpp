@@ -123,12 +123,13 @@ class LevelSolver {
   std::array<std::vector<int>, 3> wrapped_;  // per axis: coordinate x + n -> wrapped/clamped x
   std::array<AxisCover, 3> axis_cover_;
 
-  // The PCA coefficients block-major for the k-coherence scoring: 8-float
-  // block t of window j at base + (t * count + j) * 8, 64-byte aligned. The
-  // partial distances stop after the first block or two for most candidates,
-  // and the first blocks of all windows (121^2 x 32 B = 458 KiB at 128^2) fit
-  // the L2 cache where the row-major rows (1.8 MiB at 32 dimensions) did not:
-  // the first load of each candidate was ~40 % of the scoring's time (perf).
+  // The PCA coefficients for the k-coherence scoring, one 64-byte aligned
+  // row per window with a stride of whole cache lines (16 floats): the first
+  // two 8-float blocks, where most candidates are decided, are then one
+  // cache line, requested when the candidate is proposed. (Measured: Eigen's
+  // rows straddle lines; a block-major copy kept the first blocks of all
+  // windows in L2, but the many candidates that reach the second block then
+  // stalled on a second, unrequested line: ~46 % of the scoring in perf.)
   struct Centre {
     std::int32_t u, v;  // one load where ExemplarIndex's two tables took two
   };
@@ -137,8 +138,8 @@ class LevelSolver {
     std::vector<Centre> centre;  // per window
     std::vector<float> storage;
     const float* base = nullptr;
-    std::size_t count = 0;
-    const float* block(int t, int j) const { return base + (std::size_t(t) * count + std::size_t(j)) * 8; }
+    std::size_t stride = 0;  // floats per row, a multiple of 16
+    const float* row(int j) const { return base + std::size_t(j) * stride; }
   };
   std::vector<BlockedCoefficients> blocked_;
   struct Candidates {
