@@ -185,8 +185,10 @@ double LevelSolver::search(int iteration, bool exhaustive, StageProgress& progre
         out.idx.resize(max_candidates);
         int* cand = out.idx.data();
         std::size_t n = 0;
-        ++query;  // stamps start at 0, queries at 1
-        if (coherent_search) stamp[std::size_t(sink)] = query;
+        const std::uint32_t now = ++query;  // stamps start at 0, queries at 1; a local: the stores alias
+        std::uint32_t* stamps = stamp.data();
+        const int ks = k_sim;
+        stamps[sink] = now;
         const int a = int(sp / (std::size_t(w.nu) * w.nv)), sv = int((sp / w.nu) % w.nv), su = int(sp % w.nu);
         for (int dv = -1; dv <= 1; ++dv)
           for (int du = -1; du <= 1; ++du) {
@@ -204,12 +206,12 @@ double LevelSolver::search(int iteration, bool exhaustive, StageProgress& progre
               const int c = jj < 0 ? -1 : ex.index_of(cc.u - 2 * du, cc.v - 2 * dv);
               const std::size_t slot = std::size_t(c < 0 ? sink : c);
               cand[n] = c;
-              n += stamp[slot] != query;
-              stamp[slot] = query;
+              n += stamps[slot] != now;
+              stamps[slot] = now;
             };
             add_shifted(j);
             const std::int32_t* sim = ex.similar(j);
-            for (int q = 0; q < k_sim; ++q) add_shifted(sim[q]);
+            for (int q = 0; q < ks; ++q) add_shifted(sim[q]);
           }
         IndexRng rng(seed_, sp, std::uint64_t(iteration) * 3 + i);
         for (int q = 0; q < opt_.random_candidates || n == 0; ++q) cand[n++] = int(rng.below(ex.count()));
