@@ -7,6 +7,7 @@
 
 #include "exsynth/parallel.hpp"
 #include "exsynth/rng.hpp"
+#include "solid/candidate_scoring.hpp"
 
 namespace exsynth::solid {
 
@@ -65,12 +66,12 @@ LevelSolver::BlockedCoefficients LevelSolver::blocked_coefficients(const Exempla
   BlockedCoefficients b;
   b.ex = &ex;
   const std::size_t count = std::size_t(rows.rows()), cols = std::size_t(rows.cols());
-  b.stride = (cols + 15) / 16 * 16;
-  b.storage.assign(b.stride * count + 16, 0.0f);
+  const std::size_t stride = (cols + 15) / 16 * 16;
+  b.storage.assign(stride * count + 16, 0.0f);
   const std::uintptr_t addr = reinterpret_cast<std::uintptr_t>(b.storage.data());
   float* base = b.storage.data() + ((64 - addr % 64) % 64) / sizeof(float);
-  b.base = base;
-  for (std::size_t j = 0; j < count; ++j) std::copy_n(rows.row(Eigen::Index(j)).data(), cols, base + j * b.stride);
+  b.rows = {base, stride};
+  for (std::size_t j = 0; j < count; ++j) std::copy_n(rows.row(Eigen::Index(j)).data(), cols, base + j * stride);
   b.centre.resize(count);
   for (std::size_t j = 0; j < count; ++j) b.centre[j] = {ex.centre_u(int(j)), ex.centre_v(int(j))};
   return b;
@@ -218,7 +219,7 @@ double LevelSolver::search(int iteration, bool exhaustive, StageProgress& progre
         out.n = n;
         // Candidates sit at scattered exemplar positions: request their first
         // coefficients while the previous queries are scored.
-        for (std::size_t m = 0; m < n; ++m) __builtin_prefetch(blocked.row(cand[m]));
+        for (std::size_t m = 0; m < n; ++m) __builtin_prefetch(blocked.rows.row(cand[m]));
       };
       // Candidates are generated kAhead queries before they are scored, so
       // their prefetched coefficients have arrived (one query ahead, the
@@ -262,37 +263,8 @@ double LevelSolver::search(int iteration, bool exhaustive, StageProgress& progre
             const Candidates& cand_list = cand_of[k % (kAhead + 1)];
             const int* cand = cand_list.idx.data();
             const std::size_t cand_count = cand_list.n;
-            // Partial distances over 8-float blocks (the PCA space is padded
-            // to a multiple of 8): most candidates lose within the first,
-            // highest-variance dimensions, so stop as soon as they do.
-            using Block = Eigen::Matrix<float, 8, 1>;
-            float bd = std::numeric_limits<float>::max();
-            const int d = int(y.cols());
-            const float* q = y.row(Eigen::Index(k)).data();
-            // The first block of every candidate in a branch-free pass of
-            // its own, so their loads overlap (the early exit's unpredictable
-            // branches serialised them); then the early-exit scan exactly as
-            // if the first block were summed inline (same sums, same order,
-            // same ties: the first candidate of the least distance wins).
-            const bool two = d >= 16;  // the pass covers the first cache line: blocks 0 and 1
-            first_block.resize(2 * cand_count);
-            const Eigen::Map<const Block> q0(q), q1(q + (two ? 8 : 0));
-            for (std::size_t m = 0; m < cand_count; ++m) {
-              const float* e = blocked.row(cand[m]);
-              first_block[2 * m] = (Eigen::Map<const Block>(e) - q0).squaredNorm();
-              if (two) first_block[2 * m + 1] = (Eigen::Map<const Block>(e + 8) - q1).squaredNorm();
-            }
-            for (std::size_t m = 0; m < cand_count; ++m) {
-              const int c = cand[m];
-              const float* e = blocked.row(c);
-              float acc = 0.0f;
-              int t = 0;
-              if (acc < bd) acc += first_block[2 * m], t = 8;
-              if (two && acc < bd) acc += first_block[2 * m + 1], t = 16;
-              for (; t < d && acc < bd; t += 8)
-                acc += (Eigen::Map<const Block>(e + t) - Eigen::Map<const Block>(q + t)).squaredNorm();
-              if (t >= d && acc < bd) bd = acc, best = c;
-            }
+            best = nearest_candidate(y.row(Eigen::Index(k)).data(), int(y.cols()), blocked.rows, cand, cand_count,
+                                     first_block);
             if (best < 0) best = cand[0];  // every distance non-finite: never index with -1
           }
           next[sp] = best;

@@ -10,6 +10,7 @@
 #include "exsynth/grid.hpp"
 #include "exsynth/solid.hpp"
 #include "search/kd_tree.hpp"
+#include "solid/candidate_scoring.hpp"
 #include "solid/exemplar_index.hpp"
 
 namespace exsynth::solid {
@@ -137,9 +138,7 @@ class LevelSolver {
     const ExemplarIndex* ex = nullptr;
     std::vector<Centre> centre;  // per window
     std::vector<float> storage;
-    const float* base = nullptr;
-    std::size_t stride = 0;  // floats per row, a multiple of 16
-    const float* row(int j) const { return base + std::size_t(j) * stride; }
+    CoefficientRows rows;  // into storage
   };
   std::vector<BlockedCoefficients> blocked_;
   struct Candidates {
