@@ -54,16 +54,16 @@ LevelSolver::LevelSolver(Volume& texture, std::array<const ExemplarIndex*, 3> vi
     w.weight.assign(w.size(), 1.0f);
     if (opt_.search == SolidSearch::KdTree) w.kd = std::make_unique<search::KdTree>(w.ex->coefficients());
     if (opt_.search == SolidSearch::KCoherence) {
-      auto it = std::find_if(blocked_.begin(), blocked_.end(), [&](const BlockedCoefficients& b) { return b.ex == w.ex; });
-      w.blocked = int(it - blocked_.begin());
-      if (it == blocked_.end()) blocked_.push_back(blocked_coefficients(*w.ex));
+      auto it = std::find_if(scoring_.begin(), scoring_.end(), [&](const ScoringTable& b) { return b.ex == w.ex; });
+      w.scoring = int(it - scoring_.begin());
+      if (it == scoring_.end()) scoring_.push_back(scoring_table(*w.ex));
     }
   }
 }
 
-LevelSolver::BlockedCoefficients LevelSolver::blocked_coefficients(const ExemplarIndex& ex) {
+LevelSolver::ScoringTable LevelSolver::scoring_table(const ExemplarIndex& ex) {
   const RowMatrixXf& rows = ex.coefficients();  // columns padded to a multiple of 8 (ExemplarIndex)
-  BlockedCoefficients b;
+  ScoringTable b;
   b.ex = &ex;
   const std::size_t count = std::size_t(rows.rows()), cols = std::size_t(rows.cols());
   const std::size_t stride = (cols + 15) / 16 * 16;
@@ -147,8 +147,8 @@ double LevelSolver::search(int iteration, bool exhaustive, StageProgress& progre
     View& w = views_[i];
     if (!w.ex) continue;
     const ExemplarIndex& ex = *w.ex;
-    static const BlockedCoefficients kNone;
-    const BlockedCoefficients& blocked = w.blocked >= 0 ? blocked_[std::size_t(w.blocked)] : kNone;
+    static const ScoringTable kNone;
+    const ScoringTable& table = w.scoring >= 0 ? scoring_[std::size_t(w.scoring)] : kNone;
     // Matches are read from the previous round and written to a new one, so
     // the result does not depend on the order chunks run in.
     std::vector<std::int32_t> next(w.size());
@@ -203,7 +203,7 @@ double LevelSolver::search(int iteration, bool exhaustive, StageProgress& progre
             const int j = w.match[(std::size_t(a) * w.nv + nv) * w.nu + nu];
             if (j < 0) continue;
             auto add_shifted = [&](int jj) {
-              const Centre cc = blocked.centre[std::size_t(jj < 0 ? 0 : jj)];
+              const Centre cc = table.centre[std::size_t(jj < 0 ? 0 : jj)];
               const int c = jj < 0 ? -1 : ex.index_of(cc.u - 2 * du, cc.v - 2 * dv);
               const std::size_t slot = std::size_t(c < 0 ? sink : c);
               cand[n] = c;
@@ -219,7 +219,7 @@ double LevelSolver::search(int iteration, bool exhaustive, StageProgress& progre
         out.n = n;
         // Candidates sit at scattered exemplar positions: request their first
         // coefficients while the previous queries are scored.
-        for (std::size_t m = 0; m < n; ++m) __builtin_prefetch(blocked.rows.row(cand[m]));
+        for (std::size_t m = 0; m < n; ++m) __builtin_prefetch(table.rows.row(cand[m]));
       };
       // Candidates are generated kAhead queries before they are scored, so
       // their prefetched coefficients have arrived (one query ahead, the
@@ -263,7 +263,7 @@ double LevelSolver::search(int iteration, bool exhaustive, StageProgress& progre
             const Candidates& cand_list = cand_of[k % (kAhead + 1)];
             const int* cand = cand_list.idx.data();
             const std::size_t cand_count = cand_list.n;
-            best = nearest_candidate(y.row(Eigen::Index(k)).data(), int(y.cols()), blocked.rows, cand, cand_count,
+            best = nearest_candidate(y.row(Eigen::Index(k)).data(), int(y.cols()), table.rows, cand, cand_count,
                                      first_block);
             if (best < 0) best = cand[0];  // every distance non-finite: never index with -1
           }

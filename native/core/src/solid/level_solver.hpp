@@ -59,13 +59,13 @@ class LevelSolver {
     std::vector<std::int32_t> match;     // exemplar neighbourhood index per sparse voxel
     std::vector<float> weight;           // IRLS weight |s - e|^(r - 2)
     std::unique_ptr<search::KdTree> kd;  // search = KdTree only
-    int blocked = -1;                    // k-coherence: index into blocked_ (shared by views of one exemplar)
+    int scoring = -1;                    // k-coherence: index into scoring_ (shared by views of one exemplar)
     std::size_t size() const { return std::size_t(na) * nv * nu; }
   };
 
   void gather(int i, std::size_t sparse, float* row) const;
-  struct BlockedCoefficients;
-  static BlockedCoefficients blocked_coefficients(const ExemplarIndex& ex);
+  struct ScoringTable;
+  static ScoringTable scoring_table(const ExemplarIndex& ex);
 
   // The optimisation phase's pieces (level_solver.cpp).
   // Per sparse voxel, its matched window's top-left exemplar pixel (-1 = no
@@ -134,13 +134,13 @@ class LevelSolver {
   struct Centre {
     std::int32_t u, v;  // one load where ExemplarIndex's two tables took two
   };
-  struct BlockedCoefficients {
+  struct ScoringTable {
     const ExemplarIndex* ex = nullptr;
     std::vector<Centre> centre;  // per window
     std::vector<float> storage;
     CoefficientRows rows;  // into storage
   };
-  std::vector<BlockedCoefficients> blocked_;
+  std::vector<ScoringTable> scoring_;
   struct Candidates {
     std::vector<int> idx;  // capacity for the most a query proposes; the first n are its candidates
     std::size_t n = 0;
