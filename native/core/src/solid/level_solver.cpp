@@ -221,6 +221,26 @@ double LevelSolver::search(int iteration, bool exhaustive, StageProgress& progre
         // coefficients while the previous queries are scored.
         for (std::size_t m = 0; m < n; ++m) __builtin_prefetch(table.rows.row(cand[m]));
       };
+      // One query before its candidates are generated: request the similar
+      // sets and centres of its neighbours' matches (the generation's loads
+      // are a dependent chain: match -> similar set -> centre -> stamp).
+      auto warm = [&](std::size_t sp) {
+        const int a = int(sp / (std::size_t(w.nu) * w.nv)), sv = int((sp / w.nu) % w.nv), su = int(sp % w.nu);
+        for (int dv = -1; dv <= 1; ++dv)
+          for (int du = -1; du <= 1; ++du) {
+            int nu = su + du, nv = sv + dv;
+            if (wrap_) {
+              nu = nu < 0 ? nu + w.nu : (nu >= w.nu ? nu - w.nu : nu);
+              nv = nv < 0 ? nv + w.nv : (nv >= w.nv ? nv - w.nv : nv);
+            } else if (nu < 0 || nv < 0 || nu >= w.nu || nv >= w.nv) {
+              continue;
+            }
+            const int j = w.match[(std::size_t(a) * w.nv + nv) * w.nu + nu];
+            if (j < 0) continue;
+            __builtin_prefetch(ex.similar(j));
+            __builtin_prefetch(table.centre.data() + j);
+          }
+      };
       // Candidates are generated kAhead queries before they are scored, so
       // their prefetched coefficients have arrived (one query ahead, the
       // first coefficient load was a third of the scoring's time in perf).
@@ -259,6 +279,7 @@ double LevelSolver::search(int iteration, bool exhaustive, StageProgress& progre
           } else {
             // The next query's candidates first (their loads overlap this
             // query's scoring; reads only the previous round's matches).
+            if (k + kAhead + 1 < rows) warm(order[k + kAhead + 1]);
             if (k + kAhead < rows) candidates(order[k + kAhead], cand_of[(k + kAhead) % (kAhead + 1)]);
             const Candidates& cand_list = cand_of[k % (kAhead + 1)];
             const int* cand = cand_list.idx.data();
