@@ -406,7 +406,21 @@ void mean_shift(const std::vector<float>& values, const std::vector<float>& weig
 // scratch.acc; false when no window covers p. With mean shift, the texels and
 // weights are kept in scratch for it.
 bool LevelSolver::blend_voxel(const int p[3], const OptimizeTables& tables, VoxelScratch& scratch) const {
-  std::fill(scratch.acc.begin(), scratch.acc.end(), 0.0f);
+  if (C_ == 3 && !opt_.mean_shift) return blend_voxel_channels<3>(p, tables, scratch);
+  return blend_voxel_channels<0>(p, tables, scratch);
+}
+
+// kChannels > 0: that many channels, summed in locals (registers; through
+// scratch.acc every add waited on the previous store: perf), no mean shift.
+// 0: C_ channels, with mean shift when asked. Same sums in the same order.
+template <int kChannels>
+bool LevelSolver::blend_voxel_channels(const int p[3], const OptimizeTables& tables, VoxelScratch& scratch) const {
+  constexpr bool fixed = kChannels > 0;
+  const int C = fixed ? kChannels : C_;
+  float local[fixed ? kChannels : 1] = {};
+  float* acc = fixed ? local : scratch.acc.data();
+  if (!fixed) std::fill(scratch.acc.begin(), scratch.acc.end(), 0.0f);
+  const bool keep = !fixed && opt_.mean_shift;
   float wsum = 0.0f;
   scratch.values.clear();
   scratch.weights.clear();
@@ -419,7 +433,7 @@ bool LevelSolver::blend_voxel(const int p[3], const OptimizeTables& tables, Voxe
     const std::size_t slice = std::size_t(p[s.axis]) * w.nv;
     const SparseWindow* window = tables.window[i].data();
     const float* texel = tables.texel[std::size_t(tables.texel_of[i])].data();
-    const std::size_t stride = std::size_t(C_) + 1;
+    const std::size_t stride = std::size_t(C) + 1;
     for (int a = 0; a < cov.nv; ++a) {
       const std::size_t row = (slice + cov.sv[a]) * w.nu;
       const std::size_t pix_dv = std::size_t(cov.dv[a]) * img.width();
@@ -430,19 +444,19 @@ bool LevelSolver::blend_voxel(const int p[3], const OptimizeTables& tables, Voxe
         const float* t = texel + pix * stride;
         const float wt = sw.weight * t[0];
         const float* e = t + 1;
-        for (int c = 0; c < C_; ++c) scratch.acc[c] += wt * e[c];
+        for (int c = 0; c < C; ++c) acc[c] += wt * e[c];
         wsum += wt;
-        if (opt_.mean_shift) {
-          scratch.values.insert(scratch.values.end(), e, e + C_);
+        if (keep) {
+          scratch.values.insert(scratch.values.end(), e, e + C);
           scratch.weights.push_back(wt);
         }
       }
     }
   }
   if (wsum <= 0.0f) return false;
-  for (int c = 0; c < C_; ++c) scratch.acc[c] /= wsum;
-  if (opt_.mean_shift && scratch.weights.size() > 1)
-    mean_shift(scratch.values, scratch.weights, wsum, C_, scratch.acc, scratch.mode);
+  for (int c = 0; c < C; ++c) acc[c] /= wsum;
+  if (fixed) std::copy(local, local + C, scratch.acc.begin());
+  if (keep && scratch.weights.size() > 1) mean_shift(scratch.values, scratch.weights, wsum, C_, scratch.acc, scratch.mode);
   return true;
 }
 

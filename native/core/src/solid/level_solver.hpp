@@ -94,6 +94,8 @@ class LevelSolver {
   void histogram_factors(const std::vector<std::int64_t>& counts, const std::vector<double>& target,
                          OptimizeTables& tables) const;
   bool blend_voxel(const int p[3], const OptimizeTables& tables, VoxelScratch& scratch) const;
+  template <int kChannels>
+  bool blend_voxel_channels(const int p[3], const OptimizeTables& tables, VoxelScratch& scratch) const;
 
   // The sparse voxels whose windows cover voxel p in a slice of axes s: per
   // slice axis, the offsets d (0..n-1) with p - (d - lo) on the sparse grid
