@@ -407,6 +407,7 @@ TEST(Image2D, SynthesisesTheRequestedSizeAndTiles) {
   EXPECT_LT(slice_to_exemplar_distance(as_volume, 2, ex), 0.5 * slice_to_exemplar_distance(shuffled(as_volume), 2, ex));
 }
 
+#include "solid/candidate_scoring.hpp"
 #include "solid/exemplar_index.hpp"
 #include "solid/feature_channel.hpp"
 
@@ -437,6 +438,62 @@ TEST(ExemplarIndex, KdTreeCoherenceSetsComeCloseToBruteForce) {
   EXPECT_LE(fast_sum, 1.25 * ref_sum);
   EXPECT_GE(fast_sum, ref_sum * (1 - 1e-4));  // the brute force is the optimum
   EXPECT_GT(same, ref.count() * 4 / 2);       // most sets agree
+}
+
+// The k-coherence scoring (two blocks of every candidate first, then an
+// early-exit scan) against a plain scan of the same blockwise distances: the
+// same candidate, ties included (duplicate candidates, duplicate rows, a query
+// equal to a row), for every padded dimension it handles; and within float
+// rounding of Eigen's whole-row distance.
+TEST(CandidateScoring, MatchesAPlainScanIncludingTies) {
+  using Block = Eigen::Matrix<float, 8, 1>;
+  std::uint64_t state = 12345;
+  auto next = [&state] {  // a fixed LCG: the test's data, not the engine's
+    state = state * 6364136223846793005ULL + 1442695040888963407ULL;
+    return std::uint32_t(state >> 33);
+  };
+  std::vector<float> scratch;
+  for (int d : {8, 16, 24, 32, 40}) {
+    const std::size_t stride = (std::size_t(d) + 15) / 16 * 16, count = 150;
+    std::vector<float> storage(stride * count + 16, 0.0f);
+    const std::uintptr_t addr = reinterpret_cast<std::uintptr_t>(storage.data());
+    float* base = storage.data() + ((64 - addr % 64) % 64) / sizeof(float);
+    for (std::size_t j = 0; j < count; ++j)
+      for (int t = 0; t < d; ++t) base[j * stride + t] = float(next() % 1000) / 250.0f - 2.0f;
+    for (std::size_t j = 0; j < count; j += 10) std::copy_n(base + (j + 5) * stride, stride, base + j * stride);
+    const solid::CoefficientRows rows{base, stride};
+    int ties = 0;
+    for (int trial = 0; trial < 400; ++trial) {
+      std::vector<int> cand(1 + next() % 60);
+      for (int& c : cand) c = int(next() % count);
+      std::vector<float> q(static_cast<std::size_t>(d));
+      if (trial % 3 == 0) std::copy_n(rows.row(cand[next() % cand.size()]), d, q.data());
+      else for (float& v : q) v = float(next() % 1000) / 250.0f - 2.0f;
+      int ref = -1;
+      float ref_d = std::numeric_limits<float>::max();
+      std::vector<float> full(cand.size());
+      for (std::size_t m = 0; m < cand.size(); ++m) {
+        float acc = 0.0f;
+        for (int t = 0; t < d; t += 8)
+          acc += (Eigen::Map<const Block>(rows.row(cand[m]) + t) - Eigen::Map<const Block>(q.data() + t)).squaredNorm();
+        full[m] = acc;
+        if (acc < ref_d) ref_d = acc, ref = cand[m];
+      }
+      for (std::size_t m = 0; m < cand.size(); ++m) ties += full[m] == ref_d && cand[m] != ref;
+      const int got = solid::nearest_candidate(q.data(), d, rows, cand.data(), cand.size(), scratch);
+      ASSERT_EQ(got, ref) << "d = " << d << ", trial " << trial;
+      const float plain = (Eigen::Map<const Eigen::VectorXf>(rows.row(got), d) - Eigen::Map<const Eigen::VectorXf>(q.data(), d)).squaredNorm();
+      EXPECT_NEAR(plain, ref_d, 1e-4f * (1.0f + ref_d));
+    }
+    EXPECT_GT(ties, 0) << "the data must contain ties (d = " << d << ")";
+  }
+  // No finite distance: -1 (the caller then takes the first candidate).
+  std::vector<float> nan_rows(16 + 16, std::numeric_limits<float>::quiet_NaN());
+  const std::uintptr_t addr = reinterpret_cast<std::uintptr_t>(nan_rows.data());
+  const solid::CoefficientRows rows{nan_rows.data() + ((64 - addr % 64) % 64) / sizeof(float), 16};
+  const std::vector<float> q(8, 0.0f);
+  const int one = 0;
+  EXPECT_EQ(solid::nearest_candidate(q.data(), 8, rows, &one, 1, scratch), -1);
 }
 
 // Analysis stages report progress and can be cancelled mid-way (the brute

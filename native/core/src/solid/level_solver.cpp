@@ -7,6 +7,7 @@
 
 #include "exsynth/parallel.hpp"
 #include "exsynth/rng.hpp"
+#include "solid/candidate_scoring.hpp"
 
 namespace exsynth::solid {
 
@@ -52,7 +53,28 @@ LevelSolver::LevelSolver(Volume& texture, std::array<const ExemplarIndex*, 3> vi
     w.match.assign(w.size(), -1);
     w.weight.assign(w.size(), 1.0f);
     if (opt_.search == SolidSearch::KdTree) w.kd = std::make_unique<search::KdTree>(w.ex->coefficients());
+    if (opt_.search == SolidSearch::KCoherence) {
+      auto it = std::find_if(scoring_.begin(), scoring_.end(), [&](const ScoringTable& b) { return b.ex == w.ex; });
+      w.scoring = int(it - scoring_.begin());
+      if (it == scoring_.end()) scoring_.push_back(scoring_table(*w.ex));
+    }
   }
+}
+
+LevelSolver::ScoringTable LevelSolver::scoring_table(const ExemplarIndex& ex) {
+  const RowMatrixXf& rows = ex.coefficients();  // columns padded to a multiple of 8 (ExemplarIndex)
+  ScoringTable b;
+  b.ex = &ex;
+  const std::size_t count = std::size_t(rows.rows()), cols = std::size_t(rows.cols());
+  const std::size_t stride = (cols + 15) / 16 * 16;
+  b.storage.assign(stride * count + 16, 0.0f);
+  const std::uintptr_t addr = reinterpret_cast<std::uintptr_t>(b.storage.data());
+  float* base = b.storage.data() + ((64 - addr % 64) % 64) / sizeof(float);
+  b.rows = {base, stride};
+  for (std::size_t j = 0; j < count; ++j) std::copy_n(rows.row(Eigen::Index(j)).data(), cols, base + j * stride);
+  b.centre.resize(count);
+  for (std::size_t j = 0; j < count; ++j) b.centre[j] = {ex.centre_u(int(j)), ex.centre_v(int(j))};
+  return b;
 }
 
 LevelSolver::~LevelSolver() = default;
@@ -79,6 +101,16 @@ void LevelSolver::gather(int i, std::size_t sparse, float* row) const {
   const int* wu = wrapped_[s.u].data() + n_ + p[s.u] - lo_;
   const int* wv = wrapped_[s.v].data() + n_ + p[s.v] - lo_;
   const float* base = tex_.data() + std::size_t(p[s.axis]) * stride[s.axis] * C_;
+  if (C_ == 3) {  // RGB: three moves per texel (the loop below became a memmove call per texel: perf)
+    for (int dv = 0; dv < n_; ++dv) {
+      const float* line = base + std::size_t(wv[dv]) * stride[s.v] * 3;
+      for (int du = 0; du < n_; ++du, row += 3) {
+        const float* src = line + std::size_t(wu[du]) * stride[s.u] * 3;
+        row[0] = src[0], row[1] = src[1], row[2] = src[2];
+      }
+    }
+    return;
+  }
   for (int dv = 0; dv < n_; ++dv) {
     const float* line = base + std::size_t(wv[dv]) * stride[s.v] * C_;
     for (int du = 0; du < n_; ++du) {
@@ -115,6 +147,8 @@ double LevelSolver::search(int iteration, bool exhaustive, StageProgress& progre
     View& w = views_[i];
     if (!w.ex) continue;
     const ExemplarIndex& ex = *w.ex;
+    static const ScoringTable kNone;
+    const ScoringTable& table = w.scoring >= 0 ? scoring_[std::size_t(w.scoring)] : kNone;
     // Matches are read from the previous round and written to a new one, so
     // the result does not depend on the order chunks run in.
     std::vector<std::int32_t> next(w.size());
@@ -131,57 +165,104 @@ double LevelSolver::search(int iteration, bool exhaustive, StageProgress& progre
     const std::size_t batch = kBatch;
     const std::size_t batches = (w.size() + batch - 1) / batch;
     parallel_chunks(batches, 1, progress, [&](std::size_t b0, std::size_t b1) {
-      RowMatrixXf x(batch, D);
+      RowMatrixXf x(batch, D), centred(opt_.search != SolidSearch::Exact ? batch : 0, D);
+      RowMatrixXf y(opt_.search != SolidSearch::Exact ? batch : 0, ex.pca().basis.cols());
       std::vector<std::size_t> order(batch);
       // stamp[j] = the last query that proposed candidate j: O(1) dedupe.
-      // Coherent neighbours mostly propose the same candidates.
-      std::vector<std::uint32_t> stamp(opt_.search == SolidSearch::KCoherence ? ex.count() : 0, 0);
+      // Coherent neighbours mostly propose the same candidates. The last
+      // slot is a sink for shifts that leave the exemplar: it always holds
+      // the current query, so they are never taken.
+      const bool coherent_search = opt_.search == SolidSearch::KCoherence;
+      const int sink = ex.count();
+      std::vector<std::uint32_t> stamp(coherent_search ? std::size_t(ex.count()) + 1 : 0, 0);
       std::uint32_t query = 0;
+      const int k_sim = ex.coherence_k();
+      const std::size_t max_candidates = 9 * std::size_t(k_sim + 1) + std::size_t(std::max(opt_.random_candidates, 1));
       // k-coherence: each sparse neighbour's match, shifted to this voxel,
       // and that match's k most similar neighbourhoods, shifted likewise;
-      // plus a few random ones to escape local minima.
-      auto candidates = [&](std::size_t sp, std::vector<int>& cand) {
-        cand.clear();
-        ++query;  // stamps start at 0, queries at 1
+      // plus a few random ones to escape local minima. Branch-free appends
+      // (the dedupe's branch was unpredictable; perf) in the same order.
+      auto candidates = [&](std::size_t sp, Candidates& out) {
+        out.idx.resize(max_candidates);
+        int* cand = out.idx.data();
+        std::size_t n = 0;
+        const std::uint32_t now = ++query;  // stamps start at 0, queries at 1; a local: the stores alias
+        std::uint32_t* stamps = stamp.data();
+        const int ks = k_sim;
+        stamps[sink] = now;
         const int a = int(sp / (std::size_t(w.nu) * w.nv)), sv = int((sp / w.nu) % w.nv), su = int(sp % w.nu);
         for (int dv = -1; dv <= 1; ++dv)
           for (int du = -1; du <= 1; ++du) {
             int nu = su + du, nv = sv + dv;
-            if (wrap_) {
-              nu = (nu + w.nu) % w.nu;
-              nv = (nv + w.nv) % w.nv;
+            if (wrap_) {  // |du|, |dv| <= 1: one step wraps (no division)
+              nu = nu < 0 ? nu + w.nu : (nu >= w.nu ? nu - w.nu : nu);
+              nv = nv < 0 ? nv + w.nv : (nv >= w.nv ? nv - w.nv : nv);
             } else if (nu < 0 || nv < 0 || nu >= w.nu || nv >= w.nv) {
               continue;
             }
             const int j = w.match[(std::size_t(a) * w.nv + nv) * w.nu + nu];
             if (j < 0) continue;
             auto add_shifted = [&](int jj) {
-              if (jj < 0) return;
-              const int c = ex.index_of(ex.centre_u(jj) - 2 * du, ex.centre_v(jj) - 2 * dv);
-              if (c >= 0 && stamp[c] != query) {
-                stamp[c] = query;
-                cand.push_back(c);
-              }
+              const Centre cc = table.centre[std::size_t(jj < 0 ? 0 : jj)];
+              const int c = jj < 0 ? -1 : ex.index_of(cc.u - 2 * du, cc.v - 2 * dv);
+              const std::size_t slot = std::size_t(c < 0 ? sink : c);
+              cand[n] = c;
+              n += stamps[slot] != now;
+              stamps[slot] = now;
             };
             add_shifted(j);
             const std::int32_t* sim = ex.similar(j);
-            for (int q = 0; q < ex.coherence_k(); ++q) add_shifted(sim[q]);
+            for (int q = 0; q < ks; ++q) add_shifted(sim[q]);
           }
         IndexRng rng(seed_, sp, std::uint64_t(iteration) * 3 + i);
-        for (int q = 0; q < opt_.random_candidates || cand.empty(); ++q) cand.push_back(int(rng.below(ex.count())));
+        for (int q = 0; q < opt_.random_candidates || n == 0; ++q) cand[n++] = int(rng.below(ex.count()));
+        out.n = n;
         // Candidates sit at scattered exemplar positions: request their first
-        // coefficients while the previous query is scored.
-        for (int c : cand) __builtin_prefetch(ex.coefficients().row(c).data());
+        // coefficients while the previous queries are scored.
+        for (std::size_t m = 0; m < n; ++m) __builtin_prefetch(table.rows.row(cand[m]));
       };
-      std::vector<int> cand_of[2];
+      // One query before its candidates are generated: request the similar
+      // sets and centres of its neighbours' matches (the generation's loads
+      // are a dependent chain: match -> similar set -> centre -> stamp).
+      auto warm = [&](std::size_t sp) {
+        const int a = int(sp / (std::size_t(w.nu) * w.nv)), sv = int((sp / w.nu) % w.nv), su = int(sp % w.nu);
+        for (int dv = -1; dv <= 1; ++dv)
+          for (int du = -1; du <= 1; ++du) {
+            int nu = su + du, nv = sv + dv;
+            if (wrap_) {
+              nu = nu < 0 ? nu + w.nu : (nu >= w.nu ? nu - w.nu : nu);
+              nv = nv < 0 ? nv + w.nv : (nv >= w.nv ? nv - w.nv : nv);
+            } else if (nu < 0 || nv < 0 || nu >= w.nu || nv >= w.nv) {
+              continue;
+            }
+            const int j = w.match[(std::size_t(a) * w.nv + nv) * w.nu + nu];
+            if (j < 0) continue;
+            __builtin_prefetch(ex.similar(j));
+            __builtin_prefetch(table.centre.data() + j);
+          }
+      };
+      // Candidates are generated kAhead queries before they are scored, so
+      // their prefetched coefficients have arrived (one query ahead, the
+      // first coefficient load was a third of the scoring's time in perf).
+      constexpr std::size_t kAhead = 2;
+      Candidates cand_of[kAhead + 1];
+      std::vector<int> best_of(batch);
+      std::vector<float> first_block;
       for (std::size_t b = b0; b < b1; ++b) {
         const std::size_t first = b * batch, rows = std::min(batch, w.size() - first);
         for (std::size_t k = 0; k < rows; ++k) order[k] = sparse_of(first + k);
         for (std::size_t k = 0; k < rows; ++k) gather(i, order[k], x.row(Eigen::Index(k)).data());
-        RowMatrixXf y;
-        if (opt_.search != SolidSearch::Exact) y = ex.pca().project(x.topRows(Eigen::Index(rows)));
+        // PCA projection into buffers kept across batches: Pca::project on
+        // x.topRows() copied the batch, then centred it into a temporary, and
+        // allocated its result (same operations; ~5 % of the CPU in perf).
+        if (opt_.search != SolidSearch::Exact) {
+          const Eigen::Index r = Eigen::Index(rows);
+          centred.topRows(r) = x.topRows(r).rowwise() - ex.pca().mean;
+          y.topRows(r).noalias() = centred.topRows(r) * ex.pca().basis;
+        }
         const bool coherence = opt_.search == SolidSearch::KCoherence && !exhaustive;
-        if (coherence) candidates(order[0], cand_of[0]);
+        if (coherence)
+          for (std::size_t k = 0; k < std::min(kAhead, rows); ++k) candidates(order[k], cand_of[k % (kAhead + 1)]);
         for (std::size_t k = 0; k < rows; ++k) {
           const std::size_t sp = order[k];
           int best = -1;
@@ -198,27 +279,32 @@ double LevelSolver::search(int iteration, bool exhaustive, StageProgress& progre
           } else {
             // The next query's candidates first (their loads overlap this
             // query's scoring; reads only the previous round's matches).
-            if (k + 1 < rows) candidates(order[k + 1], cand_of[(k + 1) & 1]);
-            const std::vector<int>& cand = cand_of[k & 1];
-            // Partial distances over 8-float blocks (the PCA space is padded
-            // to a multiple of 8): most candidates lose within the first,
-            // highest-variance dimensions, so stop as soon as they do.
-            using Block = Eigen::Matrix<float, 8, 1>;
-            float bd = std::numeric_limits<float>::max();
-            const int d = int(y.cols());
-            const float* q = y.row(Eigen::Index(k)).data();
-            for (int c : cand) {
-              const float* e = ex.coefficients().row(c).data();
-              float acc = 0.0f;
-              int t = 0;
-              for (; t < d && acc < bd; t += 8)
-                acc += (Eigen::Map<const Block>(e + t) - Eigen::Map<const Block>(q + t)).squaredNorm();
-              if (t >= d && acc < bd) bd = acc, best = c;
-            }
-            if (best < 0) best = cand.front();  // every distance non-finite: never index with -1
+            if (k + kAhead + 1 < rows) warm(order[k + kAhead + 1]);
+            if (k + kAhead < rows) candidates(order[k + kAhead], cand_of[(k + kAhead) % (kAhead + 1)]);
+            const Candidates& cand_list = cand_of[k % (kAhead + 1)];
+            const int* cand = cand_list.idx.data();
+            const std::size_t cand_count = cand_list.n;
+            best = nearest_candidate(y.row(Eigen::Index(k)).data(), int(y.cols()), table.rows, cand, cand_count,
+                                     first_block);
+            if (best < 0) best = cand[0];  // every distance non-finite: never index with -1
           }
           next[sp] = best;
-          const float d2 = (ex.neighbourhoods().row(best) - x.row(Eigen::Index(k))).squaredNorm();
+          best_of[k] = best;
+        }
+        // The matches' full-dimension distances, in a pass of their own: each
+        // reads a scattered D-float exemplar row, requested kRowAhead matches
+        // before (inline after the scoring, its first load stalled: perf).
+        constexpr std::size_t kRowAhead = 2;
+        const std::size_t row_bytes = std::size_t(D) * sizeof(float);
+        auto prefetch_row = [&](std::size_t k) {
+          const char* p = reinterpret_cast<const char*>(ex.neighbourhoods().row(best_of[k]).data());
+          for (std::size_t o = 0; o < row_bytes; o += 64) __builtin_prefetch(p + o);
+        };
+        for (std::size_t k = 0; k < std::min(kRowAhead, rows); ++k) prefetch_row(k);
+        for (std::size_t k = 0; k < rows; ++k) {
+          if (k + kRowAhead < rows) prefetch_row(k + kRowAhead);
+          const std::size_t sp = order[k];
+          const float d2 = (ex.neighbourhoods().row(best_of[k]) - x.row(Eigen::Index(k))).squaredNorm();
           energy[sp] = std::pow(d2, 0.5f * r);
           // IRLS for the |.|^r energy; the floor keeps exact matches finite.
           w.weight[sp] = std::pow(std::max(d2, 1e-6f), 0.5f * (r - 2.0f));
@@ -261,24 +347,28 @@ std::vector<std::int64_t> LevelSolver::solid_histogram() const {
 // (all 1 without histogram matching). The excess sums over channels, so many
 // channels would multiply the re-weighting: the exponent is as measured on RGB
 // for up to 3 channels and scaled by 3 / C above (6 channels: half).
+// Writes the factors into slot 0 of tables.texel's pixels (the texels follow).
 void LevelSolver::histogram_factors(const std::vector<std::int64_t>& counts, const std::vector<double>& target,
-                                    std::array<std::vector<float>, 3>& factor) const {
+                                    OptimizeTables& tables) const {
   const int bins = opt_.histogram_bins;
   const double strength = C_ <= 3 || opt_.histogram_strength == 1.0 ? opt_.histogram_strength : opt_.histogram_strength * 3.0 / C_;
   const double total = double(tex_.voxel_count());
-  for (int i = 0; i < 3; ++i) {
-    const View& w = views_[i];
-    if (!w.ex) continue;
-    const Image& img = w.ex->image();
-    factor[i].assign(img.pixel_count(), 1.0f);
-    if (!opt_.histogram_matching) continue;
+  const std::size_t stride = std::size_t(C_) + 1;
+  for (std::size_t e = 0; e < tables.texel.size(); ++e) {
+    const ExemplarIndex& ex = *tables.texel_ex[e];
+    const Image& img = ex.image();
+    float* texel = tables.texel[e].data();
+    if (!opt_.histogram_matching) {
+      for (std::size_t p = 0; p < img.pixel_count(); ++p) texel[p * stride] = 1.0f;
+      continue;
+    }
     for (std::size_t p = 0; p < img.pixel_count(); ++p) {
       double excess = 0.0;
       for (int c = 0; c < C_; ++c) {
-        const std::size_t k = std::size_t(c) * bins + w.ex->bin(p, c);
+        const std::size_t k = std::size_t(c) * bins + ex.bin(p, c);
         excess += std::max(0.0, counts[k] * bins / total - target[k]);
       }
-      factor[i][p] = float(strength == 1.0 ? 1.0 / (1.0 + excess) : std::pow(1.0 + excess, -strength));
+      texel[p * stride] = float(strength == 1.0 ? 1.0 / (1.0 + excess) : std::pow(1.0 + excess, -strength));
     }
   }
 }
@@ -316,7 +406,21 @@ void mean_shift(const std::vector<float>& values, const std::vector<float>& weig
 // scratch.acc; false when no window covers p. With mean shift, the texels and
 // weights are kept in scratch for it.
 bool LevelSolver::blend_voxel(const int p[3], const OptimizeTables& tables, VoxelScratch& scratch) const {
-  std::fill(scratch.acc.begin(), scratch.acc.end(), 0.0f);
+  if (C_ == 3 && !opt_.mean_shift) return blend_voxel_channels<3>(p, tables, scratch);
+  return blend_voxel_channels<0>(p, tables, scratch);
+}
+
+// kChannels > 0: that many channels, summed in locals (registers; through
+// scratch.acc every add waited on the previous store: perf), no mean shift.
+// 0: C_ channels, with mean shift when asked. Same sums in the same order.
+template <int kChannels>
+bool LevelSolver::blend_voxel_channels(const int p[3], const OptimizeTables& tables, VoxelScratch& scratch) const {
+  constexpr bool fixed = kChannels > 0;
+  const int C = fixed ? kChannels : C_;
+  float local[fixed ? kChannels : 1] = {};
+  float* acc = fixed ? local : scratch.acc.data();
+  if (!fixed) std::fill(scratch.acc.begin(), scratch.acc.end(), 0.0f);
+  const bool keep = !fixed && opt_.mean_shift;
   float wsum = 0.0f;
   scratch.values.clear();
   scratch.weights.clear();
@@ -327,31 +431,32 @@ bool LevelSolver::blend_voxel(const int p[3], const OptimizeTables& tables, Voxe
     const Image& img = w.ex->image();
     const Covering cov = cover(p, s);
     const std::size_t slice = std::size_t(p[s.axis]) * w.nv;
-    const std::int32_t* corner = tables.window_corner[i].data();
-    const float* fac = tables.factor[i].data();
+    const SparseWindow* window = tables.window[i].data();
+    const float* texel = tables.texel[std::size_t(tables.texel_of[i])].data();
+    const std::size_t stride = std::size_t(C) + 1;
     for (int a = 0; a < cov.nv; ++a) {
       const std::size_t row = (slice + cov.sv[a]) * w.nu;
       const std::size_t pix_dv = std::size_t(cov.dv[a]) * img.width();
       for (int b = 0; b < cov.nu; ++b) {
-        const std::size_t sp = row + cov.su[b];
-        const int j = w.match[sp];
-        if (j < 0) continue;
-        const std::size_t pix = std::size_t(corner[j]) + pix_dv + cov.du[b];
-        const float wt = w.weight[sp] * fac[pix];
-        const float* e = img.data() + pix * C_;
-        for (int c = 0; c < C_; ++c) scratch.acc[c] += wt * e[c];
+        const SparseWindow& sw = window[row + cov.su[b]];
+        if (sw.corner < 0) continue;
+        const std::size_t pix = std::size_t(sw.corner) + pix_dv + cov.du[b];
+        const float* t = texel + pix * stride;
+        const float wt = sw.weight * t[0];
+        const float* e = t + 1;
+        for (int c = 0; c < C; ++c) acc[c] += wt * e[c];
         wsum += wt;
-        if (opt_.mean_shift) {
-          scratch.values.insert(scratch.values.end(), e, e + C_);
+        if (keep) {
+          scratch.values.insert(scratch.values.end(), e, e + C);
           scratch.weights.push_back(wt);
         }
       }
     }
   }
   if (wsum <= 0.0f) return false;
-  for (int c = 0; c < C_; ++c) scratch.acc[c] /= wsum;
-  if (opt_.mean_shift && scratch.weights.size() > 1)
-    mean_shift(scratch.values, scratch.weights, wsum, C_, scratch.acc, scratch.mode);
+  for (int c = 0; c < C; ++c) acc[c] /= wsum;
+  if (fixed) std::copy(local, local + C, scratch.acc.begin());
+  if (keep && scratch.weights.size() > 1) mean_shift(scratch.values, scratch.weights, wsum, C_, scratch.acc, scratch.mode);
   return true;
 }
 
@@ -375,20 +480,32 @@ void LevelSolver::optimize(int iteration, StageProgress& progress) {
   for (std::size_t k = blocks; k > 1; --k) std::swap(order[k - 1], order[shuffle.below(k)]);
   const std::size_t groups = std::min<std::size_t>(blocks, 16);
 
-  // window_corner[i][j] = pixel index of window j's top-left texel in view
-  // i's exemplar.
+  // The blend's tables (see OptimizeTables): per sparse voxel its window's
+  // top-left texel and weight; per exemplar pixel its values (the factor
+  // slot is written per group by histogram_factors).
   OptimizeTables tables;
+  const std::size_t stride = std::size_t(C_) + 1;
   for (int i = 0; i < 3; ++i) {
     const View& w = views_[i];
     if (!w.ex) continue;
-    tables.window_corner[i].resize(w.ex->count());
-    for (int j = 0; j < w.ex->count(); ++j)
-      tables.window_corner[i][j] = (w.ex->centre_v(j) - lo_) * w.ex->image().width() + (w.ex->centre_u(j) - lo_);
+    const Image& img = w.ex->image();
+    tables.window[i].resize(w.size());
+    for (std::size_t sp = 0; sp < w.size(); ++sp) {
+      const int j = w.match[sp];
+      tables.window[i][sp] = {j < 0 ? -1 : (w.ex->centre_v(j) - lo_) * img.width() + (w.ex->centre_u(j) - lo_), w.weight[sp]};
+    }
+    const auto shared = std::find(tables.texel_ex.begin(), tables.texel_ex.end(), w.ex);
+    tables.texel_of[i] = int(shared - tables.texel_ex.begin());
+    if (shared != tables.texel_ex.end()) continue;
+    tables.texel_ex.push_back(w.ex);
+    std::vector<float>& texel = tables.texel.emplace_back(img.pixel_count() * stride, 1.0f);
+    for (std::size_t p = 0; p < img.pixel_count(); ++p)
+      std::copy(img.data() + p * C_, img.data() + (p + 1) * C_, texel.data() + p * stride + 1);
   }
 
   std::vector<std::vector<std::int64_t>> deltas;
   for (std::size_t g = 0; g < groups; ++g) {
-    histogram_factors(counts, target, tables.factor);
+    histogram_factors(counts, target, tables);
     const std::size_t g0 = g * blocks / groups, g1 = (g + 1) * blocks / groups;
     deltas.assign(g1 - g0, {});
     parallel_chunks(g1 - g0, 1, progress, [&](std::size_t k0, std::size_t k1) {

@@ -10,6 +10,7 @@
 #include "exsynth/grid.hpp"
 #include "exsynth/solid.hpp"
 #include "search/kd_tree.hpp"
+#include "solid/candidate_scoring.hpp"
 #include "solid/exemplar_index.hpp"
 
 namespace exsynth::solid {
@@ -58,15 +59,31 @@ class LevelSolver {
     std::vector<std::int32_t> match;     // exemplar neighbourhood index per sparse voxel
     std::vector<float> weight;           // IRLS weight |s - e|^(r - 2)
     std::unique_ptr<search::KdTree> kd;  // search = KdTree only
+    int scoring = -1;                    // k-coherence: index into scoring_ (shared by views of one exemplar)
     std::size_t size() const { return std::size_t(na) * nv * nu; }
   };
 
   void gather(int i, std::size_t sparse, float* row) const;
+  struct ScoringTable;
+  static ScoringTable scoring_table(const ExemplarIndex& ex);
 
   // The optimisation phase's pieces (level_solver.cpp).
+  // Per sparse voxel, its matched window's top-left exemplar pixel (-1 = no
+  // match) beside its IRLS weight; per exemplar pixel, its histogram factor
+  // beside its C values (stride C + 1). A covering window then costs two
+  // loads instead of four dependent ones (match -> corner -> factor, texel),
+  // which is where the blend stalled (perf, 128^3: ~19 % of the CPU).
+  struct SparseWindow {
+    std::int32_t corner;
+    float weight;
+  };
+  // Views that share an exemplar share its texel table (one 256 KiB table
+  // for a 128^2 RGB exemplar fits the L2 cache; three did not: perf).
   struct OptimizeTables {
-    std::array<std::vector<std::int32_t>, 3> window_corner;  // per view: window j's top-left pixel index
-    std::array<std::vector<float>, 3> factor;                // per view: histogram factor per exemplar pixel
+    std::array<std::vector<SparseWindow>, 3> window;  // per view: per sparse voxel
+    std::vector<std::vector<float>> texel;            // per distinct exemplar: per pixel, factor then C values
+    std::vector<const ExemplarIndex*> texel_ex;       // the exemplar of each texel table
+    std::array<int, 3> texel_of{-1, -1, -1};          // per view: its texel table
   };
   struct VoxelScratch {
     std::vector<float> acc, mode;      // C floats each: the voxel's value, mean-shift scratch
@@ -75,8 +92,10 @@ class LevelSolver {
   std::vector<double> target_histogram() const;
   std::vector<std::int64_t> solid_histogram() const;
   void histogram_factors(const std::vector<std::int64_t>& counts, const std::vector<double>& target,
-                         std::array<std::vector<float>, 3>& factor) const;
+                         OptimizeTables& tables) const;
   bool blend_voxel(const int p[3], const OptimizeTables& tables, VoxelScratch& scratch) const;
+  template <int kChannels>
+  bool blend_voxel_channels(const int p[3], const OptimizeTables& tables, VoxelScratch& scratch) const;
 
   // The sparse voxels whose windows cover voxel p in a slice of axes s: per
   // slice axis, the offsets d (0..n-1) with p - (d - lo) on the sparse grid
@@ -106,6 +125,28 @@ class LevelSolver {
   std::vector<float> channel_lo_, channel_hi_;
   std::array<std::vector<int>, 3> wrapped_;  // per axis: coordinate x + n -> wrapped/clamped x
   std::array<AxisCover, 3> axis_cover_;
+
+  // The PCA coefficients for the k-coherence scoring, one 64-byte aligned
+  // row per window with a stride of whole cache lines (16 floats): the first
+  // two 8-float blocks, where most candidates are decided, are then one
+  // cache line, requested when the candidate is proposed. (Measured: Eigen's
+  // rows straddle lines; a block-major copy kept the first blocks of all
+  // windows in L2, but the many candidates that reach the second block then
+  // stalled on a second, unrequested line: ~46 % of the scoring in perf.)
+  struct Centre {
+    std::int32_t u, v;  // one load where ExemplarIndex's two tables took two
+  };
+  struct ScoringTable {
+    const ExemplarIndex* ex = nullptr;
+    std::vector<Centre> centre;  // per window
+    std::vector<float> storage;
+    CoefficientRows rows;  // into storage
+  };
+  std::vector<ScoringTable> scoring_;
+  struct Candidates {
+    std::vector<int> idx;  // capacity for the most a query proposes; the first n are its candidates
+    std::size_t n = 0;
+  };
 };
 
 }  // namespace exsynth::solid

@@ -225,7 +225,8 @@ void check_constraint(const Job& job, int channels) {
 void check_texture_memory(const Job& job, const TextureOptimizationOptions& opt, const PreparedExemplars& p) {
   const int n = opt.neighborhood, channels = p.channels;
   const double voxels = double(job.finest.voxels());
-  double texture_bytes = voxels * channels * 4.0 * 2.0 + voxels * 3.0 / 4.0 * 16.0;
+  // (+ 8 bytes per sparse voxel and view: the optimisation's window table, level_solver.hpp)
+  double texture_bytes = voxels * channels * 4.0 * 2.0 + voxels * 3.0 / 4.0 * (16.0 + 8.0);
   if (opt.exemplar_values) texture_bytes += voxels * 4.0;  // TextureResult::source
   if (p.constraint && !p.constraint->empty()) texture_bytes += voxels * (channels + 1) * 4.0 * 8.0 / 7.0;
   double exemplar_bytes = 0;
