@@ -327,10 +327,8 @@ void optimize_level(solid::LevelSolver& solver, const Job& job, const TextureOpt
   for (int it = 0; it < iterations; ++it) {
     // The coarsest level has no coherent matches to start from and is
     // small: search it exhaustively (in PCA space) until matches settle.
-    // A coordinates start's first search is exhaustive too: the inherited
-    // matches fit the coarser optimiser's soft texture, not the crisp one.
     if (ctx) ctx->set_stage(stage + " search");
-    const double energy = solver.search(it, (coarsest && it < 2) || (crisp_start && it == 0), progress);
+    const double energy = solver.search(it, coarsest && it < 2, progress);
     if (!std::isfinite(energy))
       throw Error("the " + job.name + "'s energy became " + std::to_string(energy) +
                   " (not finite) at level " + std::to_string(l + 1) + "; this is a bug, please report it with the exemplar");
@@ -397,6 +395,8 @@ TextureResult optimize_texture(const Job& job, const TextureOptimizationOptions&
   std::vector<std::unique_ptr<solid::ExemplarIndex>> prev_index;
   const Volume empty;
   const int start_level = job.solid && job.solid->coordinate_start > 0 ? L - job.solid->coordinate_start : -1;
+  TextureOptimizationOptions crisp_opt = opt;  // outlives the solvers that refer to it
+  crisp_opt.search = SolidSearch::KdTree;
   for (int l = 0; l < L; ++l) {
     const double p0 = done / total_work, p1 = (done + double(dims[l].voxels())) / total_work;
     done += double(dims[l].voxels());
@@ -425,7 +425,10 @@ TextureResult optimize_texture(const Job& job, const TextureOptimizationOptions&
                    : resize_trilinear(tex, d.d[0], d.d[1], d.d[2], wrap ? Boundary::Wrap : Boundary::Clamp);
     }
     const Volume& constraint = constraint_levels.empty() ? empty : constraint_levels[pyr];
-    auto solver = std::make_unique<solid::LevelSolver>(tex, views, constraint, opt, wrap,
+    // A coordinates start's level searches with the k-d tree (ANN in PCA
+    // space): its first search must not lean on the inherited matches, and
+    // an exhaustive one took 72 s CPU at 64^3 (docs/solid.md, eighth pass).
+    auto solver = std::make_unique<solid::LevelSolver>(tex, views, constraint, crisp_start ? crisp_opt : opt, wrap,
                                                        hash_index(opt.seed, std::uint64_t(l), 0x5EED), lo, hi);
     if (l > 0) solver->inherit_matches(*previous);
     optimize_level(*solver, job, opt, d, l, crisp_start, energy_scale, p0, p1, ctx, result);
