@@ -117,7 +117,7 @@ def test_image_synthesis_tileable():
     ({"views": "x"}, _native.InvalidInputError, ["two active views"]),
     ({"views": "xw"}, _native.InvalidInputError, ["views"]),
     ({"search": "fastest"}, _native.InvalidInputError, ["search must be"]),
-    ({"colour": 3}, _native.InvalidInputError, ["unknown option 'colour'", "method, coordinate_coherence_k, levels"]),
+    ({"colour": 3}, _native.InvalidInputError, ["unknown option 'colour'", "method, coordinate_coherence_k, coordinate_start, levels"]),
     ({"size": 2000}, _native.OverBudgetError, ["lower the size"]),
 ])
 def test_bad_solid_inputs(kwargs, exc, words):
