@@ -20,11 +20,19 @@ def main(argv):
     ap.add_argument("--out", required=True)
     ap.add_argument("--method", default=None, help="a SOLID_METHODS name (default: the add-on's)")
     ap.add_argument("--size", type=int, default=64)
+    ap.add_argument("--options", default="",
+                    help="extra engine options for the solid, e.g. \"coordinate_start=1, finest_iterations=1\" "
+                         "(a developer's experiment: wraps _native.synthesize_solid)")
     ap.add_argument("--samples", type=int, default=16)
     ap.add_argument("--resolution", type=int, nargs=2, default=(960, 720))
     args = ap.parse_args(argv)
     sys.path.insert(0, os.path.join(os.path.abspath(args.build), "addon"))
     from exsynth import demo, demo_stage
+    if args.options:
+        from exsynth import _native
+        extra = eval(f"dict({args.options})", {})  # noqa: S307 - a developer's command line
+        plain = _native.synthesize_solid
+        _native.synthesize_solid = lambda *a, **kw: plain(*a, **{**kw, **extra})
 
     demo_stage.RESOLUTION_PX = tuple(args.resolution)
     root = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
