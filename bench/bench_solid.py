@@ -8,7 +8,7 @@ so speed and quality are read together. The coordinates rows' energy is
 another unit (the last correction pass's mean crossbar cost in appearance
 space); "cpu s" is the whole process's user+sys.
 
-usage: bench_solid.py --build BUILD_DIR [--cases solid128,solid256,image256,coord64,coord128,cstart128]
+usage: bench_solid.py --build BUILD_DIR [--cases solid128,solid256,image256,coord64,coord128]
 """
 import argparse
 import json
@@ -27,9 +27,6 @@ CASES = {
     # method="coordinates" (exemplar coordinates; the solid rows above use the default method)
     "coord64": ("solid 64^3 RGB, coordinates", "res = _native.synthesize_solid(ex, size=64, seed=1, method='coordinates')"),
     "coord128": ("solid 128^3 RGB, coordinates", "res = _native.synthesize_solid(ex, size=128, seed=1, method='coordinates')"),
-    # the optimiser's finest level started from a coordinates solid (docs/solid.md, eighth pass)
-    "cstart128": ("solid 128^3 RGB, coordinate_start=1", "res = _native.synthesize_solid(ex, size=128, levels=3, seed=1, "
-                  "coordinate_start=1, finest_iterations=1)"),
 }
 DEFAULT_CASES = "solid128,solid256,image256"
 

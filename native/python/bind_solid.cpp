@@ -81,7 +81,6 @@ py::kwargs set_solid_options(SolidOptions& o, const py::kwargs& kw) {
     const std::string k = py::str(item.first);
     if (k == "method") o.method = solid_method_from_name(string_arg(item.second, k, "'optimization' or 'coordinates'"));
     else if (k == "coordinate_coherence_k") o.coordinate_coherence_k = int_arg(item.second, k, 0, 16);
-    else if (k == "coordinate_start") o.coordinate_start = int_arg(item.second, k, 0, 8, "(0 = off; k = the k-th level from the finest starts from a coordinates solid)");
     else rest[item.first] = item.second;
   }
   return rest;
@@ -202,7 +201,7 @@ void bind_solid(py::module_& m) {
         }
         SolidOptions opt;
         opt.size = int_arg(size, "size", 1, 2048, "voxels per edge");
-        set_common(opt, set_solid_options(opt, kw), std::string("method, coordinate_coherence_k, coordinate_start, ") + kCommonNames);
+        set_common(opt, set_solid_options(opt, kw), std::string("method, coordinate_coherence_k, ") + kCommonNames);
         TextureResult r;
         {
           py::gil_scoped_release release;
@@ -233,7 +232,6 @@ max_exemplar_size=256 (working resolution: larger exemplars are halved until the
 method=SOLID_DEFAULT_METHOD ('optimization': Kopf et al. 2007; 'coordinates': exemplar coordinates after
 Dong et al. 2008, which uses levels, iterations, finest_iterations, coordinate_coherence_k=1 (0..16), pca_variance, max_pca_dims,
 max_exemplar_size, tileable, memory_budget and seed, and takes no constraint),
-coordinate_start=0 (optimization: k >= 1 = the k-th level from the finest starts from a coordinates solid; no constraint),
 memory_budget=0 (default), seed=0. size: min_texture_size(levels, neighborhood) .. SOLID_MAX_SIZE.
 Returns {'solid': (Z, Y, X, C) float32, 'energy': [...], 'energy_level': [...]}.)doc");
 

@@ -623,16 +623,3 @@ TEST(Solid, CancelInsideTheExemplarValuesPass) {
   EXPECT_TRUE(image.threw_cancelled);
   EXPECT_EQ(image.stage_at_throw, "image: level 2/2 exemplar values");
 }
-
-// coordinate_start: the coordinates synthesis runs on a private context
-// (its progress would move the bar backwards) that forwards the cancel
-// checks, so cancelling during it stops the job in that stage.
-TEST(Solid, CancelInsideTheCoordinatesStart) {
-  const Image ex = disc_texture(32, 32, 3, 23);
-  SolidOptions o = small_options();
-  o.coordinate_start = 1;
-  const auto outcome = exsynth::testing::cancel_in_stage(
-      [&](ExecContext* ctx) { synthesize_solid(one_exemplar(ex), o, ctx); }, "solid: level 2/2 coordinates start");
-  EXPECT_TRUE(outcome.threw_cancelled);
-  EXPECT_EQ(outcome.stage_at_throw, "solid: level 2/2 coordinates start");
-}

@@ -117,7 +117,7 @@ def test_image_synthesis_tileable():
     ({"views": "x"}, _native.InvalidInputError, ["two active views"]),
     ({"views": "xw"}, _native.InvalidInputError, ["views"]),
     ({"search": "fastest"}, _native.InvalidInputError, ["search must be"]),
-    ({"colour": 3}, _native.InvalidInputError, ["unknown option 'colour'", "method, coordinate_coherence_k, coordinate_start, levels"]),
+    ({"colour": 3}, _native.InvalidInputError, ["unknown option 'colour'", "method, coordinate_coherence_k, levels"]),
     ({"size": 2000}, _native.OverBudgetError, ["lower the size"]),
 ])
 def test_bad_solid_inputs(kwargs, exc, words):
@@ -392,38 +392,3 @@ def test_coordinate_solid_refuses_a_constraint_and_is_deterministic():
     b = _native.with_threads(1, lambda: optimizer_solid(ex, size=16, levels=1, method="coordinates",
                                                                   seed=4)["solid"])
     np.testing.assert_array_equal(a, b)
-
-
-# --- coordinate_start: the optimiser's finest level started from a coordinates solid ---
-
-def test_coordinate_start_is_crisper_than_the_plain_optimiser():
-    # Measured (32^3, 2 levels, seed 7; docs/solid.md, eighth pass), sharpness /
-    # contrast: granite1 plain 0.58 / 0.65, coordinate_start=1 with one finest
-    # round 0.75 / 0.77. The start must survive the level's search and the
-    # exemplar values (a start rebuilt from the coarser matches, or searched
-    # only among the inherited candidates, lost it: 0.55 / 0.51 on stone33 at 64^3).
-    ex = exemplar("granite1.png", size=64)
-    E = quality.Exemplar(ex)
-    plain = quality.volume_metrics(E, optimizer_solid(ex, size=32, levels=2, seed=7)["solid"], slices=4)["mean"]
-    crisp = quality.volume_metrics(E, optimizer_solid(ex, size=32, levels=2, seed=7, coordinate_start=1,
-                                                      finest_iterations=1)["solid"], slices=4)["mean"]
-    assert crisp["sharpness"] >= plain["sharpness"] + 0.1, (crisp, plain)
-    assert crisp["contrast"] >= plain["contrast"] + 0.05, (crisp, plain)
-
-
-def test_coordinate_start_is_deterministic_and_checks_its_inputs():
-    ex = exemplar(size=32)
-    runs = [_native.with_threads(t, lambda: optimizer_solid(ex, size=16, levels=2, neighborhood=5, seed=3,
-                                                            coordinate_start=2)["solid"]) for t in (1, 2, 8)]
-    for r in runs[1:]:
-        np.testing.assert_array_equal(runs[0], r)
-    # it changes the result (the level starts elsewhere)
-    plain = optimizer_solid(ex, size=16, levels=2, neighborhood=5, seed=3)["solid"]
-    assert not np.array_equal(plain, runs[0])
-    with pytest.raises(_native.InvalidInputError, match="coordinate_start must be between 0 .off. and levels .2."):
-        optimizer_solid(ex, size=16, levels=2, neighborhood=5, coordinate_start=3)
-    c = np.zeros((16, 16, 16, 4), np.float32)
-    with pytest.raises(_native.InvalidInputError, match="coordinate_start cannot be combined with a constraint"):
-        optimizer_solid(ex, size=16, levels=2, neighborhood=5, coordinate_start=1, constraint=c)
-    with pytest.raises(_native.InvalidInputError, match="coordinate_start cannot be combined with the feature"):
-        optimizer_solid(ex, size=16, levels=2, neighborhood=5, coordinate_start=1, feature_weight=1.0)

@@ -151,14 +151,6 @@ struct SolidOptions : TextureOptimizationOptions {
   /// similar texels). 0 = the neighbours' own texels only: measured as good
   /// as 1 and 4, and faster (64^3, crackedground / stone33 / brick; docs/solid.md).
   int coordinate_coherence_k = 0;
-  /// Optimisation only: 0 = off (default); k >= 1 = the optimiser's k-th
-  /// level from the finest (1 = the finest, 2 = the one below, ... up to
-  /// levels) starts from a coordinates solid of this size, downsampled to
-  /// that level, instead of from the upsampled coarser level (the crisp
-  /// start of docs/solid.md's eighth pass); the levels above it are not
-  /// needed for its texture but still give it their matches. Takes no
-  /// constraint volume and no feature channel (as Coordinates).
-  int coordinate_start = 0;
   SolidOptions() { finest_iterations = -1; }
 };
 /// The default method's name (SolidOptions{}.method).

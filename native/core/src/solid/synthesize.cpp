@@ -12,7 +12,6 @@
 #include "exsynth/rng.hpp"
 #include "exsynth/sample.hpp"
 #include "exsynth/solid.hpp"
-#include "solid/coordinate_start.hpp"
 #include "solid/coordinate_synthesis.hpp"
 #include "solid/exemplar_index.hpp"
 #include "solid/feature_channel.hpp"
@@ -60,17 +59,6 @@ void check_edge(const std::string& what, int value, int max, const TextureOptimi
                                                                   std::to_string(o.neighborhood) + ")"
                                                             : " or a smaller neighbourhood");
   throw InvalidInput(msg);
-}
-
-void check_coordinate_start(const SolidOptions& o, const Volume& constraint) {
-  if (o.coordinate_start == 0) return;
-  if (o.coordinate_start < 0 || o.coordinate_start > o.levels)
-    throw InvalidInput("coordinate_start must be between 0 (off) and levels (" + std::to_string(o.levels) +
-                       "), got " + std::to_string(o.coordinate_start) + " (1 = the finest level starts from a coordinates solid)");
-  if (!constraint.empty())
-    throw InvalidInput("coordinate_start cannot be combined with a constraint volume yet; set coordinate_start=0 or drop the constraint");
-  if (o.feature_weight > 0)
-    throw InvalidInput("coordinate_start cannot be combined with the feature-distance channel yet; set feature_weight=0 or coordinate_start=0");
 }
 
 struct Dims {
@@ -129,7 +117,6 @@ struct Job {
   std::array<const Image*, 3> views{};  // nullptr = inactive view
   const Volume* constraint = nullptr;
   std::string name;                      // "solid" or "image", for stages and messages
-  const SolidOptions* solid = nullptr;   // solids: their options (coordinate_start)
 };
 
 // The job's exemplars as the optimiser reads them: each distinct exemplar
@@ -295,8 +282,7 @@ Volume random_texels(const Dims& d, const std::array<const solid::ExemplarIndex*
 // One level's rounds of search and optimisation (and the exemplar-values
 // pass at the finest level), energies appended to `result`.
 void optimize_level(solid::LevelSolver& solver, const Job& job, const TextureOptimizationOptions& opt, const Dims& d,
-                    int l, bool crisp_start, double energy_scale, double p0, double p1, ExecContext* ctx,
-                    TextureResult& result) {
+                    int l, double energy_scale, double p0, double p1, ExecContext* ctx, TextureResult& result) {
   const int L = opt.levels;
   const std::string stage = job.name + ": level " + std::to_string(l + 1) + "/" + std::to_string(L);
   const bool coarsest = l == 0, finest = l == L - 1;
@@ -310,13 +296,10 @@ void optimize_level(solid::LevelSolver& solver, const Job& job, const TextureOpt
   // is one the optimisation leaves too. So it is skipped (same output;
   // measured 2.1 s of 28.6 s CPU at 128^3).
   const int optimisations = exemplar_values ? iterations - 1 : iterations;
-  // A coordinates start is crisp already: rebuilding it from the coarser
-  // level's matches (coherent upsampling) would throw it away.
-  const bool rebuild = !coarsest && opt.coherent_upsampling && !crisp_start;
   StageProgress progress(ctx, stage, p0 + 0.1 * (p1 - p0), p1,
                          std::size_t(iterations) * solver.search_units() +
                              std::size_t(optimisations) * solver.optimize_units() +
-                             (rebuild ? solver.optimize_units() : 0) +
+                             (!coarsest && opt.coherent_upsampling ? solver.optimize_units() : 0) +
                              (exemplar_values ? solver.discrete_units() : 0));
   // Coherent upsampling: the finer level's texture is first rebuilt from the
   // inherited matches, i.e. from the finer exemplar's own texels, instead of
@@ -324,7 +307,7 @@ void optimize_level(solid::LevelSolver& solver, const Job& job, const TextureOpt
   // a blurred query's nearest windows are the exemplar's smoothest ones, so
   // the blur would persist. Measured (docs/solid.md): 2D sharpness 0.71 ->
   // 0.88 (crackedground), 0.36 -> 0.84 (stone33) at no search cost.
-  if (rebuild) solver.optimize(iterations, progress);
+  if (!coarsest && opt.coherent_upsampling) solver.optimize(iterations, progress);
   for (int it = 0; it < iterations; ++it) {
     // The coarsest level has no coherent matches to start from and is
     // small: search it exhaustively (in PCA space) until matches settle.
@@ -395,9 +378,6 @@ TextureResult optimize_texture(const Job& job, const TextureOptimizationOptions&
   std::unique_ptr<solid::LevelSolver> previous;
   std::vector<std::unique_ptr<solid::ExemplarIndex>> prev_index;
   const Volume empty;
-  const int start_level = job.solid && job.solid->coordinate_start > 0 ? L - job.solid->coordinate_start : -1;
-  TextureOptimizationOptions crisp_opt = opt;  // outlives the solvers that refer to it
-  crisp_opt.search = SolidSearch::KdTree;
   for (int l = 0; l < L; ++l) {
     const double p0 = done / total_work, p1 = (done + double(dims[l].voxels())) / total_work;
     done += double(dims[l].voxels());
@@ -417,22 +397,13 @@ TextureResult optimize_texture(const Job& job, const TextureOptimizationOptions&
     for (int i = 0; i < 3; ++i) views[i] = ex.image_of[i] >= 0 ? index[ex.image_of[i]].get() : nullptr;
 
     const Dims& d = dims[l];
-    const bool crisp_start = l == start_level;
-    if (crisp_start) {
-      if (ctx) ctx->set_stage(stage + " coordinates start");
-      tex = solid::coordinate_start_texture(job.views, *job.solid, L - 1 - l, ex.exponent, ctx);
-    } else {
-      tex = l == 0 ? random_texels(d, views, channels, opt.seed)
-                   : resize_trilinear(tex, d.d[0], d.d[1], d.d[2], wrap ? Boundary::Wrap : Boundary::Clamp);
-    }
+    tex = l == 0 ? random_texels(d, views, channels, opt.seed)
+                 : resize_trilinear(tex, d.d[0], d.d[1], d.d[2], wrap ? Boundary::Wrap : Boundary::Clamp);
     const Volume& constraint = constraint_levels.empty() ? empty : constraint_levels[pyr];
-    // A coordinates start's level searches with the k-d tree (ANN in PCA
-    // space): its first search must not lean on the inherited matches, and
-    // an exhaustive one took 72 s CPU at 64^3 (docs/solid.md, eighth pass).
-    auto solver = std::make_unique<solid::LevelSolver>(tex, views, constraint, crisp_start ? crisp_opt : opt, wrap,
+    auto solver = std::make_unique<solid::LevelSolver>(tex, views, constraint, opt, wrap,
                                                        hash_index(opt.seed, std::uint64_t(l), 0x5EED), lo, hi);
     if (l > 0) solver->inherit_matches(*previous);
-    optimize_level(*solver, job, opt, d, l, crisp_start, energy_scale, p0, p1, ctx, result);
+    optimize_level(*solver, job, opt, d, l, energy_scale, p0, p1, ctx, result);
     previous = std::move(solver);
     prev_index = std::move(index);  // the solver's views point into these
   }
@@ -473,9 +444,7 @@ TextureResult synthesize_solid(const SolidExemplars& ex, const SolidOptions& opt
   }
   if (active < 2) throw InvalidInput("a solid needs at least two active views (x, y, z); got " + std::to_string(active));
   if (opt.method == SolidMethod::Coordinates) return solid::synthesize_coordinates(job.views, ex.constraint, opt, ctx);
-  check_coordinate_start(opt, ex.constraint);
   job.constraint = &ex.constraint;
-  job.solid = &opt;
   return optimize_texture(job, opt, opt.tileable, ctx);
 }
 
