@@ -21,7 +21,7 @@ def main(argv):
     ap.add_argument("--method", default=None, help="a SOLID_METHODS name (default: the add-on's)")
     ap.add_argument("--size", type=int, default=64)
     ap.add_argument("--options", default="",
-                    help="extra engine options for the solid, e.g. \"coordinate_start=1, finest_iterations=1\" "
+                    help="extra engine options for the solid, e.g. \"finest_iterations=1\" "
                          "(a developer's experiment: wraps _native.synthesize_solid)")
     ap.add_argument("--samples", type=int, default=16)
     ap.add_argument("--resolution", type=int, nargs=2, default=(960, 720))
