@@ -178,6 +178,25 @@ double LevelSolver::search(int iteration, bool exhaustive, StageProgress& progre
       std::uint32_t query = 0;
       const int k_sim = ex.coherence_k();
       const std::size_t max_candidates = 9 * std::size_t(k_sim + 1) + std::size_t(std::max(opt_.random_candidates, 1));
+      // Sparse voxel sp as (slice, v, u): computed once per query.
+      struct Slot {
+        int a, sv, su;
+      };
+      auto slot_of = [&](std::size_t sp) {
+        return Slot{int(sp / (std::size_t(w.nu) * w.nv)), int((sp / w.nu) % w.nv), int(sp % w.nu)};
+      };
+      // The match of a slot's neighbour (du, dv) in its slice, or negative
+      // (outside a clamped solid, or no match yet).
+      auto neighbour_match = [&](const Slot& at, int du, int dv) -> int {
+        int nu = at.su + du, nv = at.sv + dv;
+        if (wrap_) {  // |du|, |dv| <= 1: one step wraps (no division)
+          nu = nu < 0 ? nu + w.nu : (nu >= w.nu ? nu - w.nu : nu);
+          nv = nv < 0 ? nv + w.nv : (nv >= w.nv ? nv - w.nv : nv);
+        } else if (nu < 0 || nv < 0 || nu >= w.nu || nv >= w.nv) {
+          return -1;
+        }
+        return w.match[(std::size_t(at.a) * w.nv + nv) * w.nu + nu];
+      };
       // k-coherence: each sparse neighbour's match, shifted to this voxel,
       // and that match's k most similar neighbourhoods, shifted likewise;
       // plus a few random ones to escape local minima. Branch-free appends
@@ -190,17 +209,10 @@ double LevelSolver::search(int iteration, bool exhaustive, StageProgress& progre
         std::uint32_t* stamps = stamp.data();
         const int ks = k_sim;
         stamps[sink] = now;
-        const int a = int(sp / (std::size_t(w.nu) * w.nv)), sv = int((sp / w.nu) % w.nv), su = int(sp % w.nu);
+        const Slot at = slot_of(sp);
         for (int dv = -1; dv <= 1; ++dv)
           for (int du = -1; du <= 1; ++du) {
-            int nu = su + du, nv = sv + dv;
-            if (wrap_) {  // |du|, |dv| <= 1: one step wraps (no division)
-              nu = nu < 0 ? nu + w.nu : (nu >= w.nu ? nu - w.nu : nu);
-              nv = nv < 0 ? nv + w.nv : (nv >= w.nv ? nv - w.nv : nv);
-            } else if (nu < 0 || nv < 0 || nu >= w.nu || nv >= w.nv) {
-              continue;
-            }
-            const int j = w.match[(std::size_t(a) * w.nv + nv) * w.nu + nu];
+            const int j = neighbour_match(at, du, dv);
             if (j < 0) continue;
             auto add_shifted = [&](int jj) {
               const Centre cc = table.centre[std::size_t(jj < 0 ? 0 : jj)];
@@ -225,17 +237,10 @@ double LevelSolver::search(int iteration, bool exhaustive, StageProgress& progre
       // sets and centres of its neighbours' matches (the generation's loads
       // are a dependent chain: match -> similar set -> centre -> stamp).
       auto warm = [&](std::size_t sp) {
-        const int a = int(sp / (std::size_t(w.nu) * w.nv)), sv = int((sp / w.nu) % w.nv), su = int(sp % w.nu);
+        const Slot at = slot_of(sp);
         for (int dv = -1; dv <= 1; ++dv)
           for (int du = -1; du <= 1; ++du) {
-            int nu = su + du, nv = sv + dv;
-            if (wrap_) {
-              nu = nu < 0 ? nu + w.nu : (nu >= w.nu ? nu - w.nu : nu);
-              nv = nv < 0 ? nv + w.nv : (nv >= w.nv ? nv - w.nv : nv);
-            } else if (nu < 0 || nv < 0 || nu >= w.nu || nv >= w.nv) {
-              continue;
-            }
-            const int j = w.match[(std::size_t(a) * w.nv + nv) * w.nu + nu];
+            const int j = neighbour_match(at, du, dv);
             if (j < 0) continue;
             __builtin_prefetch(ex.similar(j));
             __builtin_prefetch(table.centre.data() + j);
