@@ -15,6 +15,7 @@
 #include "image/coordinate_synthesis.hpp"
 #include "image/patch_refinement.hpp"
 #include "support/cancel.hpp"
+#include "support/errors.hpp"
 #include "support/textures.hpp"
 #include "support/threads.hpp"
 
@@ -224,12 +225,7 @@ TEST(ImageCoordinates, BadOptionsNameTheOption) {
   auto message = [&](auto change) {
     ImageSynthesisOptions o = small_image();
     change(o);
-    try {
-      synthesize_image(ex, o);
-    } catch (const InvalidInput& e) {
-      return std::string(e.what());
-    }
-    return std::string("no error");
+    return exsynth::testing::invalid_input_message([&] { synthesize_image(ex, o); });
   };
   EXPECT_THAT(message([](auto& o) { o.coordinates.jitter = -1; }), HasSubstr("jitter must be"));
   EXPECT_THAT(message([](auto& o) { o.coordinates.jitter_from = 3; }), HasSubstr("jitter_from must be a power of two"));

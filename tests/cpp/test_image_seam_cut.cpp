@@ -17,6 +17,7 @@
 #include "image/max_flow.hpp"
 #include "image/seam_cut.hpp"
 #include "support/cancel.hpp"
+#include "support/errors.hpp"
 #include "support/textures.hpp"
 #include "support/threads.hpp"
 
@@ -316,12 +317,7 @@ TEST(ImageSeamCut, BadOptionsNameTheOption) {
   auto message = [&](auto change) {
     ImageSynthesisOptions o = small_cut_image();
     change(o);
-    try {
-      synthesize_image(ex, o);
-    } catch (const InvalidInput& e) {
-      return std::string(e.what());
-    }
-    return std::string("no error");
+    return exsynth::testing::invalid_input_message([&] { synthesize_image(ex, o); });
   };
   EXPECT_THAT(message([](auto& o) { o.coordinates.cut_passes = 17; }), HasSubstr("cut_passes must be between 0 and 16"));
   EXPECT_THAT(message([](auto& o) { o.coordinates.cut_window = 3; }), HasSubstr("cut_window must be between 4 and 256"));
