@@ -217,28 +217,35 @@ double SeamCutter::expand(CoordImage& s, const CoordImage& start, const Window& 
       e0[std::size_t(node[k])] += leave(k, cur[k]);
       e1[std::size_t(node[k])] += leave(k, cand[k]);
     }
-  // Pairs (k, m = k + e) with at least one node; x = 1 means "takes alpha".
-  for (int j = 0; j < ph; ++j)
-    for (int i = 0; i < pw; ++i)
-      for (auto [ex, ey] : {std::pair{1, 0}, std::pair{0, 1}}) {
-        if (i + ex >= pw || j + ey >= ph) continue;
-        const std::size_t k = std::size_t(j) * pw + i, m = std::size_t(j + ey) * pw + std::size_t(i + ex);
-        if (pix[k] < 0 || pix[m] < 0 || (node[k] < 0 && node[m] < 0)) continue;
-        const double A = pair_cost(cur[k], cur[m], ex, ey);
-        if (node[k] >= 0 && node[m] >= 0) {
-          const double B = pair_cost(cur[k], cand[m], ex, ey), C = pair_cost(cand[k], cur[m], ex, ey),
-                       D = pair_cost(cand[k], cand[m], ex, ey);
-          // A + (C - A) x_k + (D - C) x_m + (B + C - A - D) (1 - x_k) x_m; the
-          // last coefficient is >= 0 (the seam cost is a metric) up to rounding.
-          e1[std::size_t(node[k])] += C - A;
-          e1[std::size_t(node[m])] += D - C;
-          flow.add_edge(node[k], node[m], std::max(B + C - A - D, 0.0), 0.0);
-        } else if (node[k] >= 0) {
-          e1[std::size_t(node[k])] += pair_cost(cand[k], cur[m], ex, ey) - A;
-        } else {
-          e1[std::size_t(node[m])] += pair_cost(cur[k], cand[m], ex, ey) - A;
+  // Every 4-neighbour pair (k, m = k + (ex, ey)) of the padded window whose
+  // pixels both exist, as f(k, m, ex, ey).
+  auto for_each_pair = [&](auto&& f) {
+    for (int j = 0; j < ph; ++j)
+      for (int i = 0; i < pw; ++i)
+        for (auto [ex, ey] : {std::pair{1, 0}, std::pair{0, 1}}) {
+          if (i + ex >= pw || j + ey >= ph) continue;
+          const std::size_t k = std::size_t(j) * pw + i, m = std::size_t(j + ey) * pw + std::size_t(i + ex);
+          if (pix[k] >= 0 && pix[m] >= 0) f(k, m, ex, ey);
         }
-      }
+  };
+  // Pairs with at least one node; x = 1 means "takes alpha".
+  for_each_pair([&](std::size_t k, std::size_t m, int ex, int ey) {
+    if (node[k] < 0 && node[m] < 0) return;
+    const double A = pair_cost(cur[k], cur[m], ex, ey);
+    if (node[k] >= 0 && node[m] >= 0) {
+      const double B = pair_cost(cur[k], cand[m], ex, ey), C = pair_cost(cand[k], cur[m], ex, ey),
+                   D = pair_cost(cand[k], cand[m], ex, ey);
+      // A + (C - A) x_k + (D - C) x_m + (B + C - A - D) (1 - x_k) x_m; the
+      // last coefficient is >= 0 (the seam cost is a metric) up to rounding.
+      e1[std::size_t(node[k])] += C - A;
+      e1[std::size_t(node[m])] += D - C;
+      flow.add_edge(node[k], node[m], std::max(B + C - A - D, 0.0), 0.0);
+    } else if (node[k] >= 0) {
+      e1[std::size_t(node[k])] += pair_cost(cand[k], cur[m], ex, ey) - A;
+    } else {
+      e1[std::size_t(node[m])] += pair_cost(cur[k], cand[m], ex, ey) - A;
+    }
+  });
   // Unary terms: x = 1 costs e1 (cut source -> i when i is on the sink side), x = 0 costs e0.
   for (int v = 0; v < nodes; ++v) {
     const double d = e1[std::size_t(v)] - e0[std::size_t(v)];
@@ -255,14 +262,10 @@ double SeamCutter::expand(CoordImage& s, const CoordImage& start, const Window& 
   double delta = 0.0;
   for (std::size_t k = 0; k < n; ++k)
     if (node[k] >= 0) delta += leave(k, next[k]) - leave(k, cur[k]);
-  for (int j = 0; j < ph; ++j)
-    for (int i = 0; i < pw; ++i)
-      for (auto [ex, ey] : {std::pair{1, 0}, std::pair{0, 1}}) {
-        if (i + ex >= pw || j + ey >= ph) continue;
-        const std::size_t k = std::size_t(j) * pw + i, m = std::size_t(j + ey) * pw + std::size_t(i + ex);
-        if (pix[k] < 0 || pix[m] < 0 || (next[k] == cur[k] && next[m] == cur[m])) continue;
-        delta += double(pair_cost(next[k], next[m], ex, ey)) - double(pair_cost(cur[k], cur[m], ex, ey));
-      }
+  for_each_pair([&](std::size_t k, std::size_t m, int ex, int ey) {
+    if (next[k] == cur[k] && next[m] == cur[m]) return;
+    delta += double(pair_cost(next[k], next[m], ex, ey)) - double(pair_cost(cur[k], cur[m], ex, ey));
+  });
   if (!(delta < 0.0)) return 0.0;
   for (std::size_t k = 0; k < n; ++k)
     if (node[k] >= 0) s.s[std::size_t(pix[k])] = next[k];
@@ -273,13 +276,15 @@ void SeamCutter::run(CoordImage& s, ExecContext* ctx, double lo, double hi, std:
   if (opt_.cut_passes <= 0 || s.s.empty()) return;
   // Tileable images under 3 pixels across: a window would hold its own border.
   if (tileable_ && (s.width < 3 || s.height < 3)) return;
+  std::size_t match_rows = 0;  // the match advances once per row of patch corners
+  if (opt_.cut_matches) {
+    const PatchRefiner refiner(colours_, lo_, hi_, opt_, tileable_, seed_);
+    match_rows = refiner.corners(s.height, refiner.patch(s)).size();
+  }
   std::size_t total = 0;
   for (int pass = 0; pass < opt_.cut_passes; ++pass) {
     for (const auto& cls : windows(s, pass)) total += cls.size();
-    if (opt_.cut_matches) {  // the match advances once per row of patch corners
-      const PatchRefiner refiner(colours_, lo_, hi_, opt_, tileable_, seed_);
-      total += refiner.corners(s.height, refiner.patch(s)).size();
-    }
+    total += match_rows;
   }
   StageProgress progress(ctx, "image: seam cuts", lo, hi, total);
   const CoordImage start = s;

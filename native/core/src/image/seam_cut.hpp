@@ -20,7 +20,8 @@
 // Kolmogorov & Zabih 2004). Moves are local: windows of cut_window^2
 // pixels whose one-pixel border stays fixed, alpha running over the
 // cut_labels commonest sources in the window and its border (the
-// neighbouring regions). Windows of one of 2 x 2 classes never touch, so a
+// neighbouring regions). Windows of one of 2 x 2 classes (3 x 3 when a
+// tileable axis has an odd count of windows) never touch, so a
 // class runs in parallel with one result on any thread count; pass k shifts
 // the window grid by half a window on odd passes so seams can cross
 // window edges. A move is kept only when it lowers E (evaluated directly),
