@@ -127,6 +127,13 @@ class ExSynthSettings(bpy.types.PropertyGroup):
         items=SOLID_METHOD_ITEMS,
         default=_native.SOLID_DEFAULT_METHOD.upper(),
     )
+    solid_feature_weight: FloatProperty(
+        name="Feature Weight",
+        description="How much the distance to the edges of the exemplar's dark features (cracks, mortar, "
+        "veins) guides the Optimization method's matching: higher keeps them crisper and whole, 0 = colours "
+        "only. The Coordinates method ignores it",
+        default=_native.SOLID_DEFAULT_FEATURE_WEIGHT, min=0.0, max=100.0, soft_max=8.0,
+    )
     solid_scale: FloatProperty(
         name="Scale",
         description="Edge length of one tile of the solid, in the units of the solid's Volume object "

@@ -146,6 +146,22 @@ def test_solid_method_coordinates_and_a_bad_method(tmp_path, capsys):
     assert not (tmp_path / "t.npy").exists()
 
 
+def test_solid_feature_weight(tmp_path, capsys):
+    outs = []
+    for weight in ("0", "3"):
+        outs.append(tmp_path / f"w{weight}.npy")
+        code, err = run(capsys, "solid", "--exemplar", CRACKED, "--size", "16", "--levels", "2", "--iterations", "1",
+                        "--feature-weight", weight, "--out", str(outs[-1]))
+        assert code == 0, err
+    plain, featured = (np.load(p) for p in outs)
+    assert plain.shape == featured.shape == (16, 16, 16, 3) and not np.array_equal(plain, featured)
+    for weight, message in (("-1", "--feature-weight must be >= 0 (got -1.0)"), ("101", "feature_weight")):
+        code, err = run(capsys, "solid", "--exemplar", CRACKED, *FAST_SOLID, "--feature-weight", weight,
+                        "--out", str(tmp_path / "bad.npy"))
+        assert code != 0 and message in err, err
+    assert not (tmp_path / "bad.npy").exists()
+
+
 @pytest.mark.parametrize("method", ["coordinates", "optimization"])
 def test_run_image_keeps_to_the_memory_budget_with_either_method(tmp_path, capsys, method):
     out = tmp_path / "x.png"

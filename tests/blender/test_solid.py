@@ -647,3 +647,20 @@ def test_coordinates_method_refuses_an_exemplar_too_small_for_its_levels(cow, ex
     settings().solid_size = 32
     exemplar.scale(16, 16)
     run_expecting_error("too small for method 'coordinates'", objects=[cow])
+
+
+# ---- feature weight (the optimiser's feature-distance channel) --------------------------------
+def test_feature_weight_defaults_to_the_engines_and_reaches_it(cow, exemplar):
+    assert settings().solid_feature_weight == pytest.approx(_native.SOLID_DEFAULT_FEATURE_WEIGHT)
+    assert _native.SOLID_DEFAULT_FEATURE_WEIGHT > 0
+    assert run() == {'FINISHED'}
+    featured, _, _ = read_solid(bpy.data.objects["crackedground_solid"])
+    settings().solid_feature_weight = 0.0
+    assert run() == {'FINISHED'}
+    plain, _, _ = read_solid(bpy.data.objects["crackedground_solid.001"])
+    assert featured.shape == plain.shape and not np.array_equal(featured, plain)
+    # What the engine makes from the same exemplar with the weight off.
+    ex = solid_ops.read_exemplars(exemplar)[0]
+    direct = _native.synthesize_solid(ex, size=16, levels=2, iterations=2, seed=settings().seed,
+                                      method="optimization", feature_weight=0.0)["solid"]
+    np.testing.assert_allclose(plain, direct, atol=1e-6)

@@ -554,8 +554,37 @@ TEST(Solid, FeatureChannelGuidesMatchingAndIsDropped) {
   const Volume baseline = shuffled(r.texture);
   for (int axis = 0; axis < 3; ++axis)
     EXPECT_LT(slice_to_exemplar_distance(r.texture, axis, ex), 0.5 * slice_to_exemplar_distance(baseline, axis, ex));
+}
+
+// The feature channel is the solver's, not the caller's: a constraint names
+// the exemplar's channels (C + 1 = target values, weight), its targets win
+// where the weight is 1 and the rest of the solid is synthesized as usual.
+TEST(Solid, FeatureChannelWorksWithAConstraint) {
+  const Image ex = disc_texture(32, 32, 3, 15);
+  SolidOptions o = small_options();
+  ASSERT_GT(o.feature_weight, 0.0);  // the solids' default
   SolidExemplars constrained = one_exemplar(ex);
   constrained.constraint = Volume(o.size, o.size, o.size, 4);
+  const float target[3] = {0.25f, 0.5f, 0.75f};
+  auto pinned = [&](int x, int y, int z) { return x < 8 && y < 8 && z < 8; };
+  for (int z = 0; z < o.size; ++z)
+    for (int y = 0; y < o.size; ++y)
+      for (int x = 0; x < o.size; ++x) {
+        if (!pinned(x, y, z)) continue;
+        for (int c = 0; c < 3; ++c) constrained.constraint.at(x, y, z, c) = target[c];
+        constrained.constraint.at(x, y, z, 3) = 1.0f;
+      }
+  const TextureResult r = synthesize_solid(constrained, o);
+  ASSERT_EQ(r.texture.channels(), 3);
+  for (int z = 0; z < o.size; ++z)
+    for (int y = 0; y < o.size; ++y)
+      for (int x = 0; x < o.size; ++x)
+        if (pinned(x, y, z))
+          for (int c = 0; c < 3; ++c) ASSERT_EQ(r.texture.at(x, y, z, c), target[c]) << x << " " << y << " " << z;
+  const Volume baseline = shuffled(r.texture);
+  EXPECT_LT(slice_to_exemplar_distance(r.texture, 2, ex), 0.5 * slice_to_exemplar_distance(baseline, 2, ex));
+  // A constraint with the feature channel's count (C + 2) is the caller's mistake.
+  constrained.constraint = Volume(o.size, o.size, o.size, 5);
   EXPECT_THROW(synthesize_solid(constrained, o), InvalidInput);
 }
 

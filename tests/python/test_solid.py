@@ -129,6 +129,18 @@ def test_bad_solid_inputs(kwargs, exc, words):
         assert w in str(info.value)
 
 
+def test_feature_channel_with_a_constraint():
+    # The solids' default feature weight adds a channel inside the engine; a
+    # constraint names the exemplar's channels only, and its targets win.
+    assert _native.SOLID_DEFAULT_FEATURE_WEIGHT > 0
+    c = np.zeros((16, 16, 16, 4), np.float32)
+    c[:4, :4, :4] = (0.25, 0.5, 0.75, 1.0)
+    s = optimizer_solid(exemplar(size=48), size=16, levels=1, constraint=c, seed=2)["solid"]
+    assert s.shape == (16, 16, 16, 3)
+    np.testing.assert_array_equal(s[:4, :4, :4], np.broadcast_to(np.float32([0.25, 0.5, 0.75]), (4, 4, 4, 3)))
+    assert s[8:].std(axis=(0, 1, 2)).min() > 0.02
+
+
 def test_cancel_and_progress():
     ctx = _native.ExecContext()
     ctx.cancel()

@@ -148,6 +148,7 @@ class SolidJob(Job):
     levels: int = _native.DEFAULT_LEVELS
     iterations: int = _native.DEFAULT_ITERATIONS
     method: str = None              # one of _native.SOLID_METHODS; None = the engine's default
+    feature_weight: float = _native.SOLID_DEFAULT_FEATURE_WEIGHT  # the optimiser's; 0 = off
     scale: float = 1.0              # edge length of one tile
     seed: int = 0
     memory_budget: int = 0          # bytes; 0 = the engine's default
@@ -164,6 +165,7 @@ class SolidJob(Job):
             self.exemplar, exemplar_y=self.exemplar_y, exemplar_z=self.exemplar_z, size=self.size,
             levels=self.levels, iterations=self.iterations, seed=self.seed,
             memory_budget=self.memory_budget, ctx=ctx, method=self.method or _native.SOLID_DEFAULT_METHOD,
+            feature_weight=self.feature_weight,
         )
         solid = Solid(res["solid"], self.scale / self.size, list(res["energy"]))
         baked = bake_targets(solid.values, solid.origin, solid.voxel_size, self.targets, self.bake, ctx,
@@ -351,7 +353,8 @@ class EXSYNTH_OT_solid_texture(JobOperator, bpy.types.Operator):
             name=exemplar_name(settings.solid_exemplar), exemplar=exemplar,
             exemplar_y=exemplar_y, exemplar_z=exemplar_z, size=settings.solid_size,
             levels=settings.solid_levels, iterations=settings.solid_iterations,
-            method=settings.solid_method.lower(), scale=settings.solid_scale, seed=settings.seed,
+            method=settings.solid_method.lower(), feature_weight=settings.solid_feature_weight,
+            scale=settings.solid_scale, seed=settings.seed,
             memory_budget=settings.memory_budget_bytes, encoding=encoding, anchor=anchor,
             targets=targets, bake=BakeOptions(settings.solid_bake_resolution),
         )

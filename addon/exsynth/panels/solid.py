@@ -77,7 +77,11 @@ class EXSYNTH_PT_solid_advanced(SidebarPanel, bpy.types.Panel):
 
     def draw(self, context):
         layout = self._layout()
-        layout.prop(context.scene.exsynth, "solid_method")
+        settings = context.scene.exsynth
+        layout.prop(settings, "solid_method")
+        row = layout.row()
+        row.active = settings.solid_method == 'OPTIMIZATION'  # the other method ignores it
+        row.prop(settings, "solid_feature_weight")
         draw_shared_advanced(layout, context.scene.exsynth)
 
 

@@ -84,9 +84,6 @@ TextureResult synthesize_coordinates(const std::array<const Image*, 3>& view_ima
                                      const SolidOptions& opt, ExecContext* ctx) {
   if (!constraint.empty())
     throw InvalidInput("method 'coordinates' does not take a constraint volume yet; use method='optimization'");
-  if (opt.feature_weight > 0)
-    throw InvalidInput("method 'coordinates' has no feature-distance channel; set feature_weight=0 or use "
-                       "method='optimization'");
   if (opt.coordinate_coherence_k < 0 || opt.coordinate_coherence_k > 16)
     throw InvalidInput("coordinate_coherence_k must be between 0 and 16, got " + std::to_string(opt.coordinate_coherence_k));
   const int L = opt.levels;

@@ -526,10 +526,7 @@ void LevelSolver::optimize(int iteration, StageProgress& progress) {
             for (int x = x0; x < std::min(x0 + B, dims[0]); ++x) {
               const int p[3] = {x, y, z};
               if (!blend_voxel(p, tables, scratch)) continue;
-              if (!constraint_.empty()) {
-                const float wc = std::clamp(constraint_.at(x, y, z, C_), 0.0f, 1.0f);
-                for (int c = 0; c < C_; ++c) acc[c] = (1.0f - wc) * acc[c] + wc * constraint_.at(x, y, z, c);
-              }
+              constrain(x, y, z, acc.data());
               float* out = tex_.data() + tex_.offset(x, y, z);
               for (int c = 0; c < C_; ++c) {
                 if (hist) {
@@ -600,10 +597,7 @@ void LevelSolver::discrete(StageProgress& progress, std::vector<std::int32_t>* s
         float* out = tex_.data() + tex_.offset(x, y, z);
         const float* e = views_[best_view].ex->image().data() + best_pix * C_;
         std::copy(e, e + C_, out);
-        if (!constraint_.empty()) {  // a requested target still wins by its weight
-          const float wc = std::clamp(constraint_.at(x, y, z, C_), 0.0f, 1.0f);
-          for (int c = 0; c < C_; ++c) out[c] = (1.0f - wc) * out[c] + wc * constraint_.at(x, y, z, c);
-        }
+        constrain(x, y, z, out);  // a requested target still wins by its weight
         if (source) (*source)[tex_.voxel_index(x, y, z)] = std::int32_t((std::size_t(best_view) << 28) | best_pix);
       }
     }

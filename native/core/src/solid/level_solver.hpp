@@ -1,6 +1,7 @@
 #pragma once
 // One pyramid level of the texture optimisation: the matches of the sparse
 // grid for each active view, and the two phases that alternate on them.
+#include <algorithm>
 #include <array>
 #include <cstdint>
 #include <memory>
@@ -25,7 +26,9 @@ constexpr SliceAxes kSlices[3] = {{0, 1, 2}, {1, 0, 2}, {2, 0, 1}};
 class LevelSolver {
  public:
   /// `views[i]` = exemplar of the slice orthogonal to axis i, nullptr = view
-  /// inactive. `constraint`: empty or same grid as `texture` with C + 1 channels.
+  /// inactive. `constraint`: empty or same grid as `texture` with K + 1
+  /// channels, K <= C: targets for the first K channels, then a weight (the
+  /// channels after K, e.g. the feature-distance channel, are not constrained).
   /// `channel_lo/hi`: the value range the histogram bins span (as the exemplars').
   LevelSolver(Volume& texture, std::array<const ExemplarIndex*, 3> views, const Volume& constraint,
               const TextureOptimizationOptions& opt, bool wrap, std::uint64_t seed,
@@ -94,6 +97,13 @@ class LevelSolver {
   void histogram_factors(const std::vector<std::int64_t>& counts, const std::vector<double>& target,
                          OptimizeTables& tables) const;
   bool blend_voxel(const int p[3], const OptimizeTables& tables, VoxelScratch& scratch) const;
+  // Voxel (x, y, z)'s values pulled towards the constraint's targets by its weight.
+  void constrain(int x, int y, int z, float* values) const {
+    if (constraint_.empty()) return;
+    const int K = constraint_.channels() - 1;
+    const float wc = std::clamp(constraint_.at(x, y, z, K), 0.0f, 1.0f);
+    for (int c = 0; c < K; ++c) values[c] = (1.0f - wc) * values[c] + wc * constraint_.at(x, y, z, c);
+  }
   template <int kChannels>
   bool blend_voxel_channels(const int p[3], const OptimizeTables& tables, VoxelScratch& scratch) const;
 

@@ -193,10 +193,9 @@ void prepare_exemplars(const Job& job, const TextureOptimizationOptions& opt, Pr
       p.constraint = &p.scaled_constraint;
     }
   }
-  if (opt.feature_weight > 0) {  // the feature-distance channel appended
-    if (constrained)
-      throw InvalidInput("the feature-distance channel cannot be combined with a constraint volume yet; "
-                         "set feature_weight=0 or drop the constraint");
+  // The feature-distance channel, appended after the exemplar's channels: the
+  // constraint's targets (the exemplar's channels) leave it free.
+  if (opt.feature_weight > 0) {
     p.featured.reserve(p.images.size());
     for (const Image* img : p.images)
       p.featured.push_back(solid::with_feature_channel(*img, float(opt.feature_weight), opt.neighborhood));
@@ -228,7 +227,7 @@ void check_texture_memory(const Job& job, const TextureOptimizationOptions& opt,
   // (+ 8 bytes per sparse voxel and view: the optimisation's window table, level_solver.hpp)
   double texture_bytes = voxels * channels * 4.0 * 2.0 + voxels * 3.0 / 4.0 * (16.0 + 8.0);
   if (opt.exemplar_values) texture_bytes += voxels * 4.0;  // TextureResult::source
-  if (p.constraint && !p.constraint->empty()) texture_bytes += voxels * (channels + 1) * 4.0 * 8.0 / 7.0;
+  if (p.constraint && !p.constraint->empty()) texture_bytes += voxels * (p.user_channels + 1) * 4.0 * 8.0 / 7.0;
   double exemplar_bytes = 0;
   const Image* largest = p.images[0];
   for (const Image* img : p.images) {
@@ -353,7 +352,7 @@ TextureResult optimize_texture(const Job& job, const TextureOptimizationOptions&
                          " at the coarsest of " + std::to_string(L) + " levels, smaller than the " + std::to_string(n) + "x" +
                          std::to_string(n) + " neighbourhood; use a larger exemplar, fewer levels or a smaller neighbourhood");
   }
-  check_constraint(job, channels);
+  check_constraint(job, ex.user_channels);
   check_texture_memory(job, opt, ex);
   std::vector<float> lo, hi;
   value_ranges(ex.images, channels, lo, hi);
