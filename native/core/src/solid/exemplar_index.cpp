@@ -41,13 +41,15 @@ ExemplarIndex::ExemplarIndex(const Image& image, int n, double pca_variance, int
     }
   }
 
-  const int C = image_.channels();
-  bin_.resize(image_.pixel_count() * C);
-  hist_.assign(std::size_t(C) * bins_, 0.0);
+  // Histograms of the first K channels, those channel_lo/hi span (the rest,
+  // such as the feature-distance channel, are guides, not values to match).
+  const int C = image_.channels(), K = hist_channels_ = int(channel_lo.size());
+  bin_.resize(image_.pixel_count() * K);
+  hist_.assign(std::size_t(K) * bins_, 0.0);
   for (std::size_t p = 0; p < image_.pixel_count(); ++p)
-    for (int c = 0; c < C; ++c) {
+    for (int c = 0; c < K; ++c) {
       const int b = value_bin(image_.data()[p * C + c], channel_lo[c], channel_hi[c], bins_);
-      bin_[p * C + c] = std::uint8_t(b);
+      bin_[p * K + c] = std::uint8_t(b);
       hist_[std::size_t(c) * bins_ + b] += 1.0 / double(image_.pixel_count());
     }
 }

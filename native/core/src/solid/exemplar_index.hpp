@@ -26,6 +26,8 @@ class ExemplarIndex {
   /// Builds everything; `coherence_k` = 0 skips the k-coherence sets.
   /// Progress goes to [lo, hi] of `ctx` under the stage name `stage`, and
   /// each part checks for cancellation at chunk granularity.
+  /// `channel_lo/hi`: the value ranges of the first K <= C channels, the
+  /// ones histograms are kept for.
   ExemplarIndex(const Image& image, int n, double pca_variance, int max_pca_dims, int coherence_k, int bins,
                 const std::vector<float>& channel_lo, const std::vector<float>& channel_hi, ExecContext* ctx,
                 const std::string& stage, double lo, double hi, Coherence coherence = Coherence::KdTree);
@@ -58,7 +60,7 @@ class ExemplarIndex {
 
   int bins() const { return bins_; }
   /// Histogram bin of channel c of pixel p (row-major pixel index).
-  std::uint8_t bin(std::size_t p, int c) const { return bin_[p * image_.channels() + c]; }
+  std::uint8_t bin(std::size_t p, int c) const { return bin_[p * hist_channels_ + c]; }
   /// Normalised histogram: fraction of pixels in bin b of channel c.
   double histogram(int c, int b) const { return hist_[std::size_t(c) * bins_ + b]; }
 
@@ -74,7 +76,7 @@ class ExemplarIndex {
   }
 
   Image image_;
-  int n_, vw_, vh_, k_ = 0, bins_;
+  int n_, vw_, vh_, k_ = 0, bins_, hist_channels_ = 0;
   std::vector<std::int32_t> centre_u_, centre_v_;
   RowMatrixXf neigh_, coeffs_;
   search::Pca pca_;

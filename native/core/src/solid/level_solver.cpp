@@ -18,6 +18,7 @@ LevelSolver::LevelSolver(Volume& texture, std::array<const ExemplarIndex*, 3> vi
                          const TextureOptimizationOptions& opt, bool wrap, std::uint64_t seed,
                          std::vector<float> channel_lo, std::vector<float> channel_hi)
     : tex_(texture), constraint_(constraint), opt_(opt), wrap_(wrap), seed_(seed), C_(texture.channels()),
+      H_(int(channel_lo.size())),
       n_(opt.neighborhood), lo_(opt.neighborhood / 2), channel_lo_(std::move(channel_lo)),
       channel_hi_(std::move(channel_hi)) {
   const int dims[3] = {tex_.nx(), tex_.ny(), tex_.nz()};
@@ -327,12 +328,12 @@ double LevelSolver::search(int iteration, bool exhaustive, StageProgress& progre
 // scaled so that a uniform histogram is 1 in every bin.
 std::vector<double> LevelSolver::target_histogram() const {
   const int bins = opt_.histogram_bins;
-  std::vector<double> target(std::size_t(C_) * bins, 0.0);
+  std::vector<double> target(std::size_t(H_) * bins, 0.0);
   int active = 0;
   for (const View& w : views_)
     if (w.ex) {
       ++active;
-      for (int c = 0; c < C_; ++c)
+      for (int c = 0; c < H_; ++c)
         for (int b = 0; b < bins; ++b) target[std::size_t(c) * bins + b] += w.ex->histogram(c, b);
     }
   for (double& t : target) t *= double(bins) / active;
@@ -341,10 +342,10 @@ std::vector<double> LevelSolver::target_histogram() const {
 
 std::vector<std::int64_t> LevelSolver::solid_histogram() const {
   const int bins = opt_.histogram_bins;
-  std::vector<std::int64_t> counts(std::size_t(C_) * bins, 0);
+  std::vector<std::int64_t> counts(std::size_t(H_) * bins, 0);
   const float* d = tex_.data();
   for (std::size_t v = 0; v < tex_.voxel_count(); ++v)
-    for (int c = 0; c < C_; ++c) ++counts[std::size_t(c) * bins + value_bin(d[v * C_ + c], channel_lo_[c], channel_hi_[c], bins)];
+    for (int c = 0; c < H_; ++c) ++counts[std::size_t(c) * bins + value_bin(d[v * C_ + c], channel_lo_[c], channel_hi_[c], bins)];
   return counts;
 }
 
@@ -356,7 +357,7 @@ std::vector<std::int64_t> LevelSolver::solid_histogram() const {
 void LevelSolver::histogram_factors(const std::vector<std::int64_t>& counts, const std::vector<double>& target,
                                     OptimizeTables& tables) const {
   const int bins = opt_.histogram_bins;
-  const double strength = C_ <= 3 || opt_.histogram_strength == 1.0 ? opt_.histogram_strength : opt_.histogram_strength * 3.0 / C_;
+  const double strength = H_ <= 3 || opt_.histogram_strength == 1.0 ? opt_.histogram_strength : opt_.histogram_strength * 3.0 / H_;
   const double total = double(tex_.voxel_count());
   const std::size_t stride = std::size_t(C_) + 1;
   for (std::size_t e = 0; e < tables.texel.size(); ++e) {
@@ -369,7 +370,7 @@ void LevelSolver::histogram_factors(const std::vector<std::int64_t>& counts, con
     }
     for (std::size_t p = 0; p < img.pixel_count(); ++p) {
       double excess = 0.0;
-      for (int c = 0; c < C_; ++c) {
+      for (int c = 0; c < H_; ++c) {
         const std::size_t k = std::size_t(c) * bins + ex.bin(p, c);
         excess += std::max(0.0, counts[k] * bins / total - target[k]);
       }
@@ -411,7 +412,9 @@ void mean_shift(const std::vector<float>& values, const std::vector<float>& weig
 // scratch.acc; false when no window covers p. With mean shift, the texels and
 // weights are kept in scratch for it.
 bool LevelSolver::blend_voxel(const int p[3], const OptimizeTables& tables, VoxelScratch& scratch) const {
+  // RGB, and RGB with the feature-distance channel (the solids' default).
   if (C_ == 3 && !opt_.mean_shift) return blend_voxel_channels<3>(p, tables, scratch);
+  if (C_ == 4 && !opt_.mean_shift) return blend_voxel_channels<4>(p, tables, scratch);
   return blend_voxel_channels<0>(p, tables, scratch);
 }
 
@@ -518,7 +521,7 @@ void LevelSolver::optimize(int iteration, StageProgress& progress) {
       std::vector<float>& acc = scratch.acc;
       for (std::size_t k = k0; k < k1; ++k) {
         std::vector<std::int64_t>& delta = deltas[k];
-        if (hist) delta.assign(std::size_t(C_) * bins, 0);
+        if (hist) delta.assign(std::size_t(H_) * bins, 0);
         const std::size_t blk = order[g0 + k];
         const int x0 = int(blk % bx) * B, y0 = int((blk / bx) % by) * B, z0 = int(blk / (std::size_t(bx) * by)) * B;
         for (int z = z0; z < std::min(z0 + B, dims[2]); ++z)
@@ -529,7 +532,7 @@ void LevelSolver::optimize(int iteration, StageProgress& progress) {
               constrain(x, y, z, acc.data());
               float* out = tex_.data() + tex_.offset(x, y, z);
               for (int c = 0; c < C_; ++c) {
-                if (hist) {
+                if (hist && c < H_) {
                   --delta[std::size_t(c) * bins + value_bin(out[c], channel_lo_[c], channel_hi_[c], bins)];
                   ++delta[std::size_t(c) * bins + value_bin(acc[c], channel_lo_[c], channel_hi_[c], bins)];
                 }

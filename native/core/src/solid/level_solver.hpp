@@ -29,7 +29,9 @@ class LevelSolver {
   /// inactive. `constraint`: empty or same grid as `texture` with K + 1
   /// channels, K <= C: targets for the first K channels, then a weight (the
   /// channels after K, e.g. the feature-distance channel, are not constrained).
-  /// `channel_lo/hi`: the value range the histogram bins span (as the exemplars').
+  /// `channel_lo/hi`: the value range the histogram bins span (as the
+  /// exemplars') for the first H <= C channels, the ones histogram matching
+  /// keeps (not the feature-distance channel: a guide, not a value).
   LevelSolver(Volume& texture, std::array<const ExemplarIndex*, 3> views, const Volume& constraint,
               const TextureOptimizationOptions& opt, bool wrap, std::uint64_t seed,
               std::vector<float> channel_lo, std::vector<float> channel_hi);
@@ -131,7 +133,7 @@ class LevelSolver {
   const TextureOptimizationOptions& opt_;
   bool wrap_;
   std::uint64_t seed_;
-  int C_, n_, lo_;
+  int C_, H_, n_, lo_;  // channels, histogram-matched channels, window size, its half
   std::vector<float> channel_lo_, channel_hi_;
   std::array<std::vector<int>, 3> wrapped_;  // per axis: coordinate x + n -> wrapped/clamped x
   std::array<AxisCover, 3> axis_cover_;

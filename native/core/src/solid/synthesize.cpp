@@ -238,7 +238,7 @@ void check_texture_memory(const Job& job, const TextureOptimizationOptions& opt,
   const std::string size = job.name == "image" ? std::to_string(job.finest.d[0]) + "x" + std::to_string(job.finest.d[1])
                                                : std::to_string(job.finest.d[0]) + "^3";
   const std::string exemplar = std::to_string(largest->width()) + "x" + std::to_string(largest->height()) + " " +
-                               std::to_string(channels) + "-channel exemplar";
+                               std::to_string(p.user_channels) + "-channel exemplar";  // as the caller gave it
   if (exemplar_bytes >= texture_bytes)
     check_memory_budget(texture_bytes + exemplar_bytes, opt.memory_budget,
                         "analysing the " + exemplar + " (" + std::to_string(n) + "x" + std::to_string(n) +
@@ -355,7 +355,7 @@ TextureResult optimize_texture(const Job& job, const TextureOptimizationOptions&
   check_constraint(job, ex.user_channels);
   check_texture_memory(job, opt, ex);
   std::vector<float> lo, hi;
-  value_ranges(ex.images, channels, lo, hi);
+  value_ranges(ex.images, ex.user_channels, lo, hi);  // histograms of the exemplar's channels only
 
   std::vector<Volume> constraint_levels;
   if (ex.constraint && !ex.constraint->empty()) {
