@@ -198,8 +198,11 @@ TEST(Solid, PerViewExemplarsTwoViewsAndManyChannels) {
   EXPECT_EQ(r.texture.channels(), 6);
   EXPECT_EQ(r.texture.nx(), 24);
   const Volume baseline = shuffled(r.texture);
-  EXPECT_LT(slice_to_exemplar_distance(r.texture, 0, ex.views[0]), 0.5 * slice_to_exemplar_distance(baseline, 0, ex.views[0]));
-  EXPECT_LT(slice_to_exemplar_distance(r.texture, 2, ex.views[2]), 0.5 * slice_to_exemplar_distance(baseline, 2, ex.views[2]));
+  // The feature-distance channel (the default) trades a little of this colour
+  // measure for crisper features: measured 0.42-0.54 of the shuffled solid's
+  // over seeds 5-7 (0.41-0.49 without it).
+  EXPECT_LT(slice_to_exemplar_distance(r.texture, 0, ex.views[0]), 0.6 * slice_to_exemplar_distance(baseline, 0, ex.views[0]));
+  EXPECT_LT(slice_to_exemplar_distance(r.texture, 2, ex.views[2]), 0.6 * slice_to_exemplar_distance(baseline, 2, ex.views[2]));
 }
 
 TEST(Solid, FinestIterationsSetsTheFinestLevelsRounds) {
