@@ -152,7 +152,8 @@ const std::string& image_doc() {
            format_number(d.cut_leave) + ", cut_reach=" + std::to_string(d.cut_reach) + ", cut_radius=" +
            std::to_string(d.cut_radius) + ", cut_matches=" + flag(d.cut_matches) +
            "; also tileable, max_exemplar_size, seed.\nmethod='optimization': the optimiser of synthesize_solid, "
-           "same options. Returns {'image': ..., 'energy': [...]}.";
+           "same options (feature_weight=" + format_number(ImageSynthesisOptions{}.feature_weight) +
+           " here). Returns {'image': ..., 'energy': [...]}.";
   }();
   return doc;
 }

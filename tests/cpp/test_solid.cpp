@@ -548,6 +548,21 @@ TEST(FeatureChannel, SignedDistanceToTheDarkFeaturesEdge) {
   EXPECT_FLOAT_EQ(f.at(10, 20, 3), 2.0f * (0.5f + 0.5f * 5.0f / 8.0f));  // 5 px outside (nearest feature pixel x = 15)
 }
 
+// Features are darker than their surroundings (the mean of the window of
+// radius `scale`), not than the whole exemplar: a dark line in a dark half
+// is one, the flat dark half away from it is not (against the global mean
+// all of it was, and a wood exemplar's dark half came out as the whole solid).
+TEST(FeatureChannel, FeaturesAreDarkerThanTheirSurroundings) {
+  Image img(64, 40, 1, 0.8f);
+  for (int y = 0; y < 40; ++y)
+    for (int x = 0; x < 32; ++x) img.at(x, y, 0) = x == 8 ? 0.05f : 0.3f;  // a dark half with a darker line
+  const Image f = solid::with_feature_channel(img, 1.0f, 4);
+  EXPECT_LT(f.at(8, 20, 1), 0.5f);         // the line: inside a feature
+  EXPECT_GT(f.at(2, 20, 1), 0.5f);         // the dark half beside it: outside
+  EXPECT_FLOAT_EQ(f.at(20, 20, 1), 1.0f);  // 12 px from the line and 8 px from the step: far outside
+  EXPECT_FLOAT_EQ(f.at(50, 20, 1), 1.0f);  // the light half
+}
+
 TEST(Solid, FeatureChannelGuidesMatchingAndIsDropped) {
   const Image ex = disc_texture(32, 32, 3, 15);
   SolidOptions o = small_options();

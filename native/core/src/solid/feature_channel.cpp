@@ -19,20 +19,46 @@ std::vector<float> distance_to(const std::vector<std::uint8_t>& mask, std::uint8
   return d2;
 }
 
+// Mean of the (2r + 1)^2 window around every pixel (edges clamped), by two
+// separable running sums: O(pixels) for any r.
+std::vector<float> local_mean(const std::vector<float>& v, int w, int h, int r) {
+  std::vector<double> rows(v.size());
+  for (int y = 0; y < h; ++y) {
+    double sum = 0.0;
+    auto at = [&](int x) { return double(v[std::size_t(y) * w + std::clamp(x, 0, w - 1)]); };
+    for (int x = -r; x <= r; ++x) sum += at(x);
+    for (int x = 0; x < w; ++x) {
+      rows[std::size_t(y) * w + x] = sum;
+      sum += at(x + r + 1) - at(x - r);
+    }
+  }
+  std::vector<float> out(v.size());
+  const double area = double(2 * r + 1) * (2 * r + 1);
+  for (int x = 0; x < w; ++x) {
+    double sum = 0.0;
+    auto at = [&](int y) { return rows[std::size_t(std::clamp(y, 0, h - 1)) * w + x]; };
+    for (int y = -r; y <= r; ++y) sum += at(y);
+    for (int y = 0; y < h; ++y) {
+      out[std::size_t(y) * w + x] = float(sum / area);
+      sum += at(y + r + 1) - at(y - r);
+    }
+  }
+  return out;
+}
+
 }  // namespace
 
 Image with_feature_channel(const Image& ex, float weight, int scale) {
   const int w = ex.width(), h = ex.height(), C = ex.channels(), L = std::min(C, 3);
   std::vector<float> lum(ex.pixel_count());
-  double mean = 0.0;
   for (std::size_t p = 0; p < lum.size(); ++p) {
     float s = 0.0f;
     for (int c = 0; c < L; ++c) s += ex.data()[p * C + c];
     lum[p] = s / L;
-    mean += lum[p] / double(lum.size());
   }
+  const std::vector<float> mean = local_mean(lum, w, h, scale);
   std::vector<std::uint8_t> feature(lum.size());
-  for (std::size_t p = 0; p < lum.size(); ++p) feature[p] = lum[p] < mean ? 1 : 0;
+  for (std::size_t p = 0; p < lum.size(); ++p) feature[p] = lum[p] < mean[p] ? 1 : 0;
   const std::vector<float> to_feature = distance_to(feature, 1, w, h);
   const std::vector<float> to_background = distance_to(feature, 0, w, h);
 

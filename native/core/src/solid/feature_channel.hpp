@@ -8,7 +8,10 @@
 
 namespace exsynth::solid {
 
-/// Appends one channel: features = pixels darker than the mean luminance;
+/// Appends one channel: features = pixels darker than the mean luminance of
+/// the (2 scale + 1)^2 window around them (cracks, mortar, grain lines; not a
+/// whole darker region: against the exemplar's global mean, drkwood2's dark
+/// half became the whole solid, contrast 0.49; docs/solid.md, ninth pass);
 /// value = weight * (0.5 + 0.5 * clamp(signed distance to the feature edge /
 /// `scale` pixels, -1, 1)), positive outside features. Exact Euclidean
 /// distances (separable transform).
