@@ -130,6 +130,8 @@ def _run_job(job, label):
 
 
 def _parser():
+    from . import demo  # for the demo's defaults (its bpy scene code loads only with the CLI)
+
     parser = argparse.ArgumentParser(
         prog="./exsynth run", description="Headless exsynth jobs (run inside Blender)."
     )
@@ -277,7 +279,8 @@ def _parser():
     p.add_argument("--out", required=True, help="folder for the PNGs")
     p.add_argument("--resolution", type=_int, default=96, help="voxels along the longest side (default 96)")
     p.add_argument("--samples", type=_int, default=16, help="Cycles samples per pixel (default 16)")
-    p.add_argument("--solid-size", type=_int, default=64, help="voxels along the solid's edge (default 64)")
+    p.add_argument("--solid-size", type=_int, default=demo.DEMO_SOLID_SIZE,
+                   help="voxels along the solid's edge (default %(default)s)")
     p.set_defaults(run=_run_demo)
     _points_parser(sub)
     _add_surface_parser(sub)

@@ -71,9 +71,13 @@ def run(bunny_path, out_dir, resolution=96, samples=16):
 
 COW_LENGTH = 2.0  # the OBJ is 1 unit long
 SOLID_SCALE = 1.0  # one tile of the solid, in world units
+# 128^3: at 64^3 the voxels are ~1/64 of the cow and its stones come out as
+# soft blotches; at 128^3 the feature channel's dark cracks show (docs/solid.md,
+# ninth pass); the solid takes ~9 s of the demo on 2 cores.
+DEMO_SOLID_SIZE = 128
 
 
-def run_solid(cow_path, exemplar_path, out_dir, size=64, samples=16, method=None, name="solid_texture.png"):
+def run_solid(cow_path, exemplar_path, out_dir, size=DEMO_SOLID_SIZE, samples=16, method=None, name="solid_texture.png"):
     """Solid-texture the bundled cow, cut open: the Solid Texture operator on
     the cow minus a box, Re-bake on the piece the box took out (then set
     beside it, cut face to the camera), so the cut faces of both show the
