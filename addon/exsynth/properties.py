@@ -19,8 +19,9 @@ SOLID_DEFAULT_LEVELS = _native.DEFAULT_LEVELS
 # The engine's solid methods (_native.SOLID_METHODS); the enum's identifiers
 # are the names upper-cased, the job passes them back lower-cased.
 _SOLID_METHOD_TEXT = {
-    "optimization": ("Optimization", "Texture optimisation of voxel values (Kopf et al. 2007): softer, takes "
-                     "the Python API's constraint volume"),
+    "optimization": ("Optimization", "Texture optimisation of voxel values (Kopf et al. 2007), guided by "
+                     "the Feature Weight: whole stones on any cut, softer slices; takes the Python API's "
+                     "constraint volume"),
     "coordinates": ("Coordinates", "Exemplar coordinates with crossbar candidates (Dong et al. 2008): every "
                     "voxel is a texel of the exemplar: crisper slices, but square blocks with straight seams "
                     "on oblique cuts"),
