@@ -524,7 +524,8 @@ def _run_solid(args):
     job = solid_ops.SolidJob(
         name=solid_ops.exemplar_name(images[0]), exemplar=exemplar, exemplar_y=exemplar_y,
         exemplar_z=exemplar_z, size=args.size, levels=args.levels, iterations=args.iterations,
-        method=args.method, feature_weight=args.feature_weight, scale=scale, seed=args.seed, memory_budget=int(args.memory_budget * GIB), encoding=encoding,
+        method=args.method, feature_weight=args.feature_weight, scale=scale, seed=args.seed,
+        memory_budget=int(args.memory_budget * GIB), encoding=encoding,
         anchor=anchor, targets=targets, bake=solid_ops.BakeOptions(args.bake_size),
     )
     result, seconds = _run_job(job, "solid")

@@ -45,10 +45,11 @@ enum class SolidSearch {
 };
 
 /// Solids' feature_weight (SolidOptions): with it the slices of 64^3 solids
-/// of 8 exemplars come out crisper (sharpness 0.66 -> 0.85, contrast 0.79 ->
-/// 0.84, hist_emd 5.3 -> 4.7) and the cow's oblique cuts show the exemplar's
-/// stones with their dark cracks where 0 gives soft blotches; 4 overshoots
-/// the sharpness of some exemplars (docs/solid.md, ninth pass).
+/// of 8 exemplars come out crisper (sharpness 0.66 -> 0.88, contrast 0.79 ->
+/// 0.89, hist_emd 5.3 -> 4.6; 16 of 32 slice targets against 8) and the
+/// cow's cut faces show stones outlined by dark cracks where 0 gives soft
+/// blotches, for nn_rel 0.53 -> 0.62 and ~18 % more CPU; 4 overshoots the
+/// sharpness of some exemplars (docs/solid.md, ninth pass).
 constexpr double kSolidFeatureWeight = 2.0;
 
 /// finest_iterations = -1: this many rounds at the finest level once it is
