@@ -51,6 +51,10 @@ enum class SolidSearch {
 /// the sharpness of some exemplars (docs/solid.md, ninth pass).
 constexpr double kSolidFeatureWeight = 2.0;
 
+/// Bins per value channel of TextureOptimizationOptions::histogram_values
+/// (the quality measure's hist_emd uses 32 over the 8-bit range).
+constexpr int kValueBins = 32;
+
 /// finest_iterations = -1: this many rounds at the finest level once it is
 /// at least kAutoFinestFrom voxels (pixels) across.
 constexpr int kAutoFinestIterations = 2;
@@ -92,6 +96,15 @@ struct TextureOptimizationOptions {
   /// weighted mean, so the output's values are the exemplar's (crisp; see
   /// docs/solid.md). Off = the paper's averaged result.
   bool exemplar_values = true;
+  /// > 0 (with exemplar_values): the exemplar-values pass matches the
+  /// exemplars' histogram. Each voxel chooses among the texels its covering
+  /// windows propose (every view), by match quality against a per-bin price
+  /// (kValueBins bins per value channel); histogram_value_rounds rounds of
+  /// choices at fixed prices raise the prices of over-full bins by this step
+  /// per unit of excess, and the round nearest the histogram is kept
+  /// (level_solver.cpp). 0 = off: the best-matching window's texel.
+  double histogram_values = 0.0;
+  int histogram_value_rounds = 8;  ///< pricing rounds of histogram_values (then one pass writes)
   /// > 0: add the feature-distance channel (signed distance to the edges of
   /// the exemplar's dark features) with this weight relative to colours in
   /// [0, 1]; it guides matching and is dropped from the output. 0 = off

@@ -1,0 +1,215 @@
+// Histogram-matched exemplar values (TextureOptimizationOptions::histogram_values).
+//
+// The plain pass (LevelSolver::discrete) gives voxel p the texel that the
+// best-matching window of the best-supported view puts there. On
+// high-contrast exemplars (stone33, brick, granite1) the solid's histogram
+// then misses the exemplar's (hist_emd 9-12 grey levels, docs/solid.md): the
+// optimisation's histogram re-weighting acts on its averages, which this pass
+// discards. Here each voxel chooses among every texel its covering windows
+// propose (all views); proposal t of view i scores
+//     S_i * (w_t / W_i) / F(t),
+// S_i = the view's summed IRLS weights over p, W_i = its best weight, w_t =
+// t's window's weight, F(t) = exp(sum over value channels c of
+// price[c][bin_c(t)]). With every price 0 the best is the plain pass's texel
+// (score S_max, the only one: see choose_value), so round 0 is that pass.
+// Prices are a Lagrangian (dual ascent) of "the solid's histogram = the
+// exemplars'": after a round of choices at fixed prices, a bin whose share
+// exceeds the target by e gets price += step * kValueBins * e (an under-full
+// one loses as much). Each voxel's choice depends only on the prices and the
+// matches, so any thread count gives the same. The round nearest the target
+// (1-D EMD summed over channels) is the one written, so the result's
+// histogram is never farther than the plain pass's.
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <mutex>
+
+#include "exsynth/parallel.hpp"
+#include "solid/level_solver.hpp"
+
+namespace exsynth::solid {
+namespace {
+
+// Sum over channels of the 1-D earth mover's distance (in bins) between the
+// histogram of `counts` (of `total` voxels) and the target fractions.
+double histogram_distance(const std::vector<std::int64_t>& counts, const std::vector<double>& target, int channels,
+                          double total) {
+  double d = 0.0;
+  for (int c = 0; c < channels; ++c) {
+    double cum = 0.0;
+    for (int b = 0; b < kValueBins; ++b) {
+      const std::size_t k = std::size_t(c) * kValueBins + b;
+      cum += double(counts[k]) / total - target[k];
+      d += std::abs(cum);
+    }
+  }
+  return d;
+}
+
+}  // namespace
+
+// The bins of every distinct exemplar's pixels and the target: the mean of
+// the active views' exemplar histograms (as target_histogram). The
+// feature-distance channel, when present (the last), is not a value the
+// output keeps, so it is not matched.
+LevelSolver::ValueTables LevelSolver::value_tables() const {
+  ValueTables vt;
+  vt.channels = C_ - (opt_.feature_weight > 0 ? 1 : 0);
+  const int V = vt.channels;
+  vt.target.assign(std::size_t(V) * kValueBins, 0.0);
+  int active = 0;
+  for (int i = 0; i < 3; ++i) {
+    const View& w = views_[i];
+    if (!w.ex) continue;
+    ++active;
+    const Image& img = w.ex->image();
+    const auto shared = std::find(vt.ex.begin(), vt.ex.end(), w.ex);
+    vt.of[i] = int(shared - vt.ex.begin());
+    if (shared == vt.ex.end()) {
+      vt.ex.push_back(w.ex);
+      std::vector<std::uint8_t>& bins = vt.bins.emplace_back(img.pixel_count() * std::size_t(V));
+      for (std::size_t p = 0; p < img.pixel_count(); ++p)
+        for (int c = 0; c < V; ++c)
+          bins[p * V + c] = std::uint8_t(value_bin(img.data()[p * C_ + c], channel_lo_[c], channel_hi_[c], kValueBins));
+      vt.factor.emplace_back(img.pixel_count(), 1.0f);
+    }
+    const std::vector<std::uint8_t>& bins = vt.bins[std::size_t(vt.of[i])];
+    const double share = 1.0 / double(img.pixel_count());
+    for (std::size_t p = 0; p < img.pixel_count(); ++p)
+      for (int c = 0; c < V; ++c) vt.target[std::size_t(c) * kValueBins + bins[p * V + c]] += share;
+  }
+  for (double& t : vt.target) t /= active;
+  return vt;
+}
+
+// Per exemplar pixel exp(sum of its bins' prices): one load per proposal in
+// choose_value instead of one per channel and an exp. The exponent is
+// clamped so a runaway price cannot make a factor 0 or infinite.
+void LevelSolver::price_factors(const std::vector<double>& price, ValueTables& vt) const {
+  const int V = vt.channels;
+  for (std::size_t e = 0; e < vt.ex.size(); ++e) {
+    const std::vector<std::uint8_t>& bins = vt.bins[e];
+    std::vector<float>& factor = vt.factor[e];
+    for (std::size_t p = 0; p < factor.size(); ++p) {
+      double sum = 0.0;
+      for (int c = 0; c < V; ++c) sum += price[std::size_t(c) * kValueBins + bins[p * V + c]];
+      factor[p] = float(std::exp(std::clamp(sum, -60.0, 60.0)));
+    }
+  }
+}
+
+// Voxel p's choice at the current prices (see the file comment). Supports
+// are summed in float in the plain pass's order and scores compared in
+// double, strictly (ties: the first in view, then scan order), so with unit
+// factors the choice is exactly the plain pass's: within the best view only
+// its first best window scores S_max, every other proposal scores below.
+LevelSolver::Choice LevelSolver::choose_value(const int p[3], const ValueTables& vt,
+                                              std::vector<Proposal>& proposals) const {
+  proposals.clear();
+  float support[3] = {0.0f, 0.0f, 0.0f}, best[3] = {0.0f, 0.0f, 0.0f};
+  for (int i = 0; i < 3; ++i) {
+    const View& w = views_[i];
+    if (!w.ex) continue;
+    const SliceAxes& s = kSlices[i];
+    const int width = w.ex->image().width();
+    const Covering cov = cover(p, s);
+    for (int a = 0; a < cov.nv; ++a) {
+      const std::size_t row_sp = (std::size_t(p[s.axis]) * w.nv + cov.sv[a]) * w.nu;
+      for (int b = 0; b < cov.nu; ++b) {
+        const std::size_t sp = row_sp + cov.su[b];
+        const int j = w.match[sp];
+        if (j < 0) continue;
+        const float wt = w.weight[sp];
+        support[i] += wt;
+        best[i] = std::max(best[i], wt);
+        const std::size_t pix =
+            std::size_t(w.ex->centre_v(j) - lo_ + cov.dv[a]) * width + (w.ex->centre_u(j) - lo_ + cov.du[b]);
+        proposals.push_back({i, pix, wt});
+      }
+    }
+  }
+  Choice choice;
+  double best_score = -1.0;
+  for (const Proposal& q : proposals) {
+    const double rel = best[q.view] > 0.0f ? double(q.weight) / double(best[q.view]) : 1.0;
+    const double score = double(support[q.view]) * rel / double(vt.factor[std::size_t(vt.of[q.view])][q.pix]);
+    if (score > best_score) best_score = score, choice = {q.view, q.pix};
+  }
+  return choice;
+}
+
+// The histogram (channels x kValueBins counts) of the choices at the current
+// prices, nothing written: a chosen texel counts by its own bins (the
+// constraint, applied when writing, pulls values the prices cannot move),
+// a voxel no window covers by the value it keeps. Integer counts: the sum
+// does not depend on the order chunks finish in.
+std::vector<std::int64_t> LevelSolver::chosen_histogram(const ValueTables& vt, StageProgress& progress) const {
+  const int dims[3] = {tex_.nx(), tex_.ny(), tex_.nz()};
+  const int V = vt.channels;
+  std::vector<std::int64_t> counts(vt.target.size(), 0);
+  std::mutex merge;
+  parallel_chunks(std::size_t(dims[1]) * dims[2], 1, progress, [&](std::size_t r0, std::size_t r1) {
+    std::vector<std::int64_t> local(counts.size(), 0);
+    std::vector<Proposal> proposals;
+    for (std::size_t row = r0; row < r1; ++row) {
+      const int y = int(row % std::size_t(dims[1])), z = int(row / std::size_t(dims[1]));
+      for (int x = 0; x < dims[0]; ++x) {
+        const int p[3] = {x, y, z};
+        const Choice ch = choose_value(p, vt, proposals);
+        if (ch.view >= 0) {
+          const std::uint8_t* bins = vt.bins[std::size_t(vt.of[ch.view])].data() + ch.pix * V;
+          for (int c = 0; c < V; ++c) ++local[std::size_t(c) * kValueBins + bins[c]];
+          continue;
+        }
+        const float* kept = tex_.data() + tex_.offset(x, y, z);
+        for (int c = 0; c < V; ++c)
+          ++local[std::size_t(c) * kValueBins + value_bin(kept[c], channel_lo_[c], channel_hi_[c], kValueBins)];
+      }
+    }
+    std::lock_guard<std::mutex> lock(merge);
+    for (std::size_t k = 0; k < counts.size(); ++k) counts[k] += local[k];
+  });
+  return counts;
+}
+
+// The choices at the current prices written as the plain pass writes its
+// own: the texel, then the constraint, and its source.
+void LevelSolver::write_values(const ValueTables& vt, StageProgress& progress, std::vector<std::int32_t>* source) {
+  const int dims[3] = {tex_.nx(), tex_.ny(), tex_.nz()};
+  if (source) source->assign(tex_.voxel_count(), -1);
+  parallel_chunks(std::size_t(dims[1]) * dims[2], 1, progress, [&](std::size_t r0, std::size_t r1) {
+    std::vector<Proposal> proposals;
+    for (std::size_t row = r0; row < r1; ++row) {
+      const int y = int(row % std::size_t(dims[1])), z = int(row / std::size_t(dims[1]));
+      for (int x = 0; x < dims[0]; ++x) {
+        const int p[3] = {x, y, z};
+        const Choice ch = choose_value(p, vt, proposals);
+        if (ch.view < 0) continue;  // no window covers p: keep the optimised value
+        float* out = tex_.data() + tex_.offset(x, y, z);
+        const float* e = views_[ch.view].ex->image().data() + ch.pix * C_;
+        std::copy(e, e + C_, out);
+        constrain(x, y, z, out);
+        if (source) (*source)[tex_.voxel_index(x, y, z)] = std::int32_t((std::size_t(ch.view) << 28) | ch.pix);
+      }
+    }
+  });
+}
+
+void LevelSolver::discrete_histogram(StageProgress& progress, std::vector<std::int32_t>* source) {
+  ValueTables vt = value_tables();
+  const double total = double(tex_.voxel_count());
+  std::vector<double> price(vt.target.size(), 0.0), kept = price;
+  double nearest = std::numeric_limits<double>::infinity();
+  for (int round = 0; round < opt_.histogram_value_rounds; ++round) {
+    price_factors(price, vt);
+    const std::vector<std::int64_t> counts = chosen_histogram(vt, progress);
+    const double d = histogram_distance(counts, vt.target, vt.channels, total);
+    if (d < nearest) nearest = d, kept = price;
+    for (std::size_t k = 0; k < price.size(); ++k)
+      price[k] += opt_.histogram_values * kValueBins * (double(counts[k]) / total - vt.target[k]);
+  }
+  price_factors(kept, vt);
+  write_values(vt, progress, source);
+}
+
+}  // namespace exsynth::solid
