@@ -675,7 +675,7 @@ Image contrasty_exemplar() { return disc_texture(32, 32, 3, 31, 20, 3.0f); }
 
 SolidOptions histogram_values_options() {
   SolidOptions o = small_options();
-  o.histogram_values = 1.0;
+  o.histogram_values = 0.3;
   return o;
 }
 

@@ -104,7 +104,12 @@ struct TextureOptimizationOptions {
   /// per unit of excess, and the round nearest the histogram is kept
   /// (level_solver.cpp). 0 = off: the best-matching window's texel.
   double histogram_values = 0.0;
-  int histogram_value_rounds = 8;  ///< pricing rounds of histogram_values (then one pass writes)
+  int histogram_value_rounds = 32;  ///< pricing rounds of histogram_values (then one pass writes)
+  /// beta in [0, 1]: a proposal pays beta x the mean price of its whole
+  /// window's texels and (1 - beta) x its own texel's. 0 = the texel's own
+  /// (each voxel on its own: speckle); towards 1 a window's voxels move
+  /// together, so the choices stay coherent pieces of exemplar.
+  double histogram_value_window = 0.0;
   /// > 0: add the feature-distance channel (signed distance to the edges of
   /// the exemplar's dark features) with this weight relative to colours in
   /// [0, 1]; it guides matching and is dropped from the output. 0 = off

@@ -56,8 +56,9 @@ class LevelSolver {
   std::size_t search_units() const;
   std::size_t optimize_units() const;
   std::size_t discrete_units() const {
-    const std::size_t passes = opt_.histogram_values > 0 ? std::size_t(opt_.histogram_value_rounds) + 1 : 1;
-    return passes * std::size_t(tex_.ny()) * tex_.nz();
+    const std::size_t rows = std::size_t(tex_.ny()) * tex_.nz();
+    if (opt_.histogram_values <= 0) return rows;
+    return rows + std::size_t(opt_.histogram_value_rounds) * ((value_sample() + kValueChunk - 1) / kValueChunk);
   }
 
  private:
@@ -110,7 +111,8 @@ class LevelSolver {
     int channels = 0;                                // value channels (the feature channel is not matched)
     std::vector<const ExemplarIndex*> ex;            // distinct exemplars
     std::vector<std::vector<std::uint8_t>> bins;     // per exemplar: pixel * channels + c
-    std::vector<std::vector<float>> factor;          // per exemplar: per pixel exp(sum of its bins' prices)
+    std::vector<std::vector<float>> factor;          // per exemplar: per pixel exp((1 - beta) x its price)
+    std::vector<std::vector<float>> window;          // per exemplar: per window corner exp(beta x mean price)
     std::array<int, 3> of{-1, -1, -1};               // per view: its exemplar's tables
     std::vector<double> target;                      // channels * kValueBins fractions
   };
@@ -118,13 +120,16 @@ class LevelSolver {
   // pixel it puts there, and the window's IRLS weight.
   struct Proposal {
     int view;
-    std::size_t pix;
+    std::size_t corner, pix;  // the window's top-left exemplar pixel, the texel's
     float weight;
   };
   struct Choice {
     int view = -1;  // -1: no window covers the voxel
     std::size_t pix = 0;
   };
+  static constexpr std::size_t kValueSample = std::size_t(1) << 15;  // voxels the pricing rounds count
+  static constexpr std::size_t kValueChunk = 1024;                   // of them per parallel chunk
+  std::size_t value_sample() const;
   ValueTables value_tables() const;
   void price_factors(const std::vector<double>& price, ValueTables& vt) const;
   Choice choose_value(const int p[3], const ValueTables& vt, std::vector<Proposal>& proposals) const;

@@ -44,6 +44,7 @@ void check_options(const TextureOptimizationOptions& o) {
   range("feature_weight", o.feature_weight, 0, 100, " (0 = off)");
   range("histogram_values", o.histogram_values, 0, 100, " (0 = off)");
   range("histogram_value_rounds", o.histogram_value_rounds, 1, 64, "");
+  range("histogram_value_window", o.histogram_value_window, 0, 1, " (0 = each texel's own price)");
   if (o.max_exemplar_size != 0) range("max_exemplar_size", o.max_exemplar_size, o.neighborhood, 1 << 16, " pixels (0 = full resolution)");
 }
 
