@@ -24,7 +24,7 @@ SolidSearch to_search(const std::string& s) {
 constexpr const char* kCommonNames =
     "levels, neighborhood, iterations, finest_iterations, r, pca_variance, max_pca_dims, search, coherence_k, "
     "random_candidates, ann_eps, histogram_matching, histogram_bins, histogram_strength, mean_shift, "
-    "coherent_upsampling, exemplar_values, feature_weight, tileable, max_exemplar_size, memory_budget, seed";
+    "coherent_upsampling, exemplar_values, histogram_values, histogram_value_rounds, histogram_value_window, feature_weight, tileable, max_exemplar_size, memory_budget, seed";
 
 // The options both entry points share, in one place; `names`: every option
 // the entry point takes, for the message about an unknown one.
@@ -50,6 +50,9 @@ void set_common(TextureOptimizationOptions& o, const py::kwargs& kw, const std::
     else if (k == "mean_shift") o.mean_shift = bool_arg(v, k);
     else if (k == "coherent_upsampling") o.coherent_upsampling = bool_arg(v, k);
     else if (k == "exemplar_values") o.exemplar_values = bool_arg(v, k);
+    else if (k == "histogram_values") o.histogram_values = real_arg(v, k, 0.0, 100.0, Ends::Closed, "0 = off");
+    else if (k == "histogram_value_rounds") o.histogram_value_rounds = int_arg(v, k, 1, 64);
+    else if (k == "histogram_value_window") o.histogram_value_window = real_arg(v, k, 0.0, 1.0);
     else if (k == "feature_weight") o.feature_weight = real_arg(v, k, 0.0, 100.0, Ends::Closed, "0 = off");
     else if (k == "tileable") o.tileable = bool_arg(v, k);
     else if (k == "max_exemplar_size") o.max_exemplar_size = int_arg(v, k, 0, 1 << 16);
@@ -229,7 +232,10 @@ target values then a weight in [0, 1]. Options (keywords): levels=3, neighborhoo
 iterations=3, finest_iterations=-1 (rounds at the finest level; 0 = iterations; -1 = 2 from 64 voxels across), r=0.8, pca_variance=0.95, max_pca_dims=32,
 search='kcoherence'|'kdtree'|'exact', coherence_k=4, random_candidates=2, ann_eps=2.0, histogram_matching=True, histogram_bins=16, histogram_strength=3
 ((1 + excess)^-strength re-weighting; 1 = gentle),
-mean_shift=False, coherent_upsampling=True, exemplar_values=True, feature_weight=SOLID_DEFAULT_FEATURE_WEIGHT (the feature-distance channel's weight; 0 = off), tileable=True,
+mean_shift=False, coherent_upsampling=True, exemplar_values=True, histogram_values=0 (> 0: the exemplar values
+match the exemplars' histogram, this being the step of the per-bin prices; 0 = off), histogram_value_rounds=32
+(its pricing rounds), histogram_value_window=0 (0..1: the share of a proposal's price taken from its whole
+window's texels, for coherent choices), feature_weight=SOLID_DEFAULT_FEATURE_WEIGHT (the feature-distance channel's weight; 0 = off), tileable=True,
 max_exemplar_size=256 (working resolution: larger exemplars are halved until they fit; 0 = never),
 method=SOLID_DEFAULT_METHOD ('optimization': Kopf et al. 2007; 'coordinates': exemplar coordinates after
 Dong et al. 2008, which uses levels, iterations, finest_iterations, coordinate_coherence_k=1 (0..16), pca_variance, max_pca_dims,

@@ -670,3 +670,108 @@ TEST(Solid, CancelInsideTheExemplarValuesPass) {
   EXPECT_TRUE(image.threw_cancelled);
   EXPECT_EQ(image.stage_at_throw, "image: level 2/2 exemplar values");
 }
+
+namespace {
+
+// Mean over channels of the 1-D earth mover's distance (in bins) between the
+// 32-bin histograms of a volume's values and an exemplar's (values in [0, 1]).
+double histogram_emd(const Volume& v, const Image& ex) {
+  const int C = ex.channels(), bins = 32;
+  double sum = 0.0;
+  for (int c = 0; c < C; ++c) {
+    const std::vector<double> a = histogram(v.data(), v.voxel_count(), C, c, bins);
+    const std::vector<double> b = histogram(ex.data(), ex.pixel_count(), C, c, bins);
+    double cum = 0.0;
+    for (int k = 0; k < bins; ++k) sum += std::abs(cum += a[k] - b[k]);
+  }
+  return sum / C;
+}
+
+// High contrast and few mid-tones: bright discs on a dark ground, where the
+// plain pass's best-matching windows over-represent the ground.
+Image contrasty_exemplar() { return disc_texture(32, 32, 3, 31, 20, 3.0f); }
+
+SolidOptions histogram_values_options() {
+  SolidOptions o = small_options();
+  o.histogram_values = 0.3;
+  return o;
+}
+
+}  // namespace
+
+// histogram_values keeps every voxel an exemplar texel, the one its source names.
+TEST(Solid, HistogramValuesAreTheExemplarsTexelsAtTheirSource) {
+  const Image ex = contrasty_exemplar();
+  const TextureResult r = synthesize_solid(one_exemplar(ex), histogram_values_options());
+  ASSERT_EQ(r.source.size(), r.texture.voxel_count());
+  for (std::size_t v = 0; v < r.texture.voxel_count(); ++v) {
+    ASSERT_GE(r.source[v], 0) << "voxel " << v << " was not covered by any window";
+    ASSERT_LT(r.source[v] >> 28, 3);
+    const std::size_t pix = std::size_t(r.source[v]) & ((std::size_t(1) << 28) - 1);
+    ASSERT_LT(pix, ex.pixel_count());
+    for (int c = 0; c < 3; ++c) ASSERT_EQ(r.texture.values()[v * 3 + c], ex.data()[pix * 3 + c]) << "voxel " << v;
+  }
+}
+
+// The point of the option: the solid's histogram comes closer to the
+// exemplar's than the plain pass's (which round 0 reproduces).
+TEST(Solid, HistogramValuesBringTheHistogramCloser) {
+  const Image ex = contrasty_exemplar();
+  SolidOptions plain = small_options();
+  const double before = histogram_emd(synthesize_solid(one_exemplar(ex), plain).texture, ex);
+  const double after = histogram_emd(synthesize_solid(one_exemplar(ex), histogram_values_options()).texture, ex);
+  EXPECT_LT(after, 0.8 * before) << "plain " << before << ", histogram-matched " << after;
+}
+
+// One round at zero prices is exactly the plain pass.
+TEST(Solid, HistogramValuesWithOneRoundAreThePlainPass) {
+  const Image ex = contrasty_exemplar();
+  SolidOptions one_round = histogram_values_options();
+  one_round.histogram_value_rounds = 1;
+  const TextureResult a = synthesize_solid(one_exemplar(ex), one_round);
+  const TextureResult b = synthesize_solid(one_exemplar(ex), small_options());
+  EXPECT_EQ(a.texture.values(), b.texture.values());
+  EXPECT_EQ(a.source, b.source);
+}
+
+TEST(Solid, HistogramValuesSameOnOneTwoAndEightThreads) {
+  const Image ex = contrasty_exemplar();
+  auto run = [&] { return synthesize_solid(one_exemplar(ex), histogram_values_options()); };
+  const TextureResult one = exsynth::testing::on_threads(1, run);
+  const TextureResult two = exsynth::testing::on_threads(2, run);
+  const TextureResult eight = exsynth::testing::on_threads(8, run);
+  EXPECT_EQ(one.texture.values(), two.texture.values());
+  EXPECT_EQ(one.texture.values(), eight.texture.values());
+  EXPECT_EQ(one.source, eight.source);
+}
+
+TEST(Solid, HistogramValuesCancel) {
+  const Image ex = contrasty_exemplar();
+  const SolidOptions o = histogram_values_options();
+  const auto outcome = exsynth::testing::cancel_in_stage(
+      [&](ExecContext* ctx) { synthesize_solid(one_exemplar(ex), o, ctx); }, "solid: level 2/2 exemplar values");
+  EXPECT_TRUE(outcome.threw_cancelled);
+  EXPECT_EQ(outcome.stage_at_throw, "solid: level 2/2 exemplar values");
+}
+
+// The constraint still wins where its weight is 1 (applied after the choice).
+TEST(Solid, HistogramValuesRespectTheConstraint) {
+  const Image ex = contrasty_exemplar();
+  SolidOptions o = histogram_values_options();
+  SolidExemplars constrained = one_exemplar(ex);
+  constrained.constraint = Volume(o.size, o.size, o.size, 4, 0.0f);
+  const float target[3] = {0.9f, 0.1f, 0.4f};
+  auto pinned = [](int x, int y, int z) { return x < 6 && y < 6 && z < 6; };
+  for (int z = 0; z < o.size; ++z)
+    for (int y = 0; y < o.size; ++y)
+      for (int x = 0; x < o.size; ++x)
+        if (pinned(x, y, z)) {
+          for (int c = 0; c < 3; ++c) constrained.constraint.at(x, y, z, c) = target[c];
+          constrained.constraint.at(x, y, z, 3) = 1.0f;
+        }
+  const TextureResult r = synthesize_solid(constrained, o);
+  for (int z = 0; z < 6; ++z)
+    for (int y = 0; y < 6; ++y)
+      for (int x = 0; x < 6; ++x)
+        for (int c = 0; c < 3; ++c) ASSERT_NEAR(r.texture.at(x, y, z, c), target[c], 1e-6) << x << " " << y << " " << z;
+}

@@ -69,7 +69,9 @@ FUNCTIONS = {
         "random_candidates": ("int", 0, 64), "ann_eps": ("real", 0, 1e6), "histogram_matching": "bool",
         "histogram_bins": ("int", 2, 256), "histogram_strength": ("real", 0, 16), "mean_shift": "bool",
         "feature_weight": ("real", 0, 100),
-        "exemplar_values": "bool", "tileable": "bool", "memory_budget": "budget", "seed": "seed", "ctx": "ctx",
+        "exemplar_values": "bool", "histogram_values": ("real", 0, 100), "histogram_value_rounds": ("int", 1, 64),
+        "histogram_value_window": ("real", 0, 1),
+        "tileable": "bool", "memory_budget": "budget", "seed": "seed", "ctx": "ctx",
         "method": "str", "coordinate_coherence_k": ("int", 0, 16)}),
     "synthesize_image": (call("synthesize_image", IMG, width=8, height=8, levels=1, iterations=1), {
         "width": ("int", 1, 16384), "height": ("int", 1, 16384), "levels": ("int", 1, 8), "r": ("real", 0, 2),

@@ -363,6 +363,21 @@ def test_exemplar_values_are_the_exemplars_texels(what):
     assert not_texels(averaged) > len(averaged) // 2
 
 
+def test_histogram_values_match_the_exemplars_histogram_with_its_texels():
+    # histogram_values (the histogram-matched exemplar-values pass): still
+    # only exemplar texels, and the solid's histogram (quality.hist_emd over
+    # all voxels, grey levels) closer to the exemplar's than the plain pass's.
+    ex = exemplar("granite1.png", size=48)
+    palette = {tuple(p) for p in ex.reshape(-1, 3).tolist()}
+    flat = lambda s: np.rint(s.reshape(-1, 3) * 255.0).astype(int)
+    plain = optimizer_solid(ex, size=32, levels=2, seed=7)["solid"]
+    matched = optimizer_solid(ex, size=32, levels=2, seed=7, histogram_values=0.3)["solid"]
+    assert all(tuple(t) in palette for t in flat(matched).tolist())
+    before = quality.hist_emd(ex.astype(np.float64), flat(plain).astype(np.float64))
+    after = quality.hist_emd(ex.astype(np.float64), flat(matched).astype(np.float64))
+    assert after < 0.7 * before, (before, after)
+
+
 def test_quality_metrics_on_known_cases():
     # The metrics themselves: an exemplar against itself is a perfect, fully
     # copied match; its 3x3 box blur is less sharp; shuffled pixels are far.

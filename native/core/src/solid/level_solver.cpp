@@ -562,6 +562,7 @@ namespace exsynth::solid {
 // or their medoid) kept less detail. Reads only the matches: each voxel's
 // choice is independent of the others, so any thread count gives the same.
 void LevelSolver::discrete(StageProgress& progress, std::vector<std::int32_t>* source) {
+  if (opt_.histogram_values > 0) return discrete_histogram(progress, source);  // histogram_values.cpp
   const int dims[3] = {tex_.nx(), tex_.ny(), tex_.nz()};
   if (source) source->assign(tex_.voxel_count(), -1);
   // Rows of voxels (y, z) in parallel: an image is a single z-slice.

@@ -50,12 +50,18 @@ class LevelSolver {
   /// best-matching covering window puts there (see level_solver.cpp).
   /// `source`, when given, receives per voxel the view and exemplar pixel taken
   /// (view * 2^28 + pixel index; -1 = no window covered it: value kept).
+  /// With opt.histogram_values > 0 the choice is histogram-matched instead
+  /// (discrete_histogram).
   void discrete(StageProgress& progress, std::vector<std::int32_t>* source = nullptr);
 
   /// Units of progress each phase reports (for StageProgress totals).
   std::size_t search_units() const;
   std::size_t optimize_units() const;
-  std::size_t discrete_units() const { return std::size_t(tex_.ny()) * tex_.nz(); }
+  std::size_t discrete_units() const {
+    const std::size_t rows = std::size_t(tex_.ny()) * tex_.nz();
+    if (opt_.histogram_values <= 0) return rows;
+    return rows + std::size_t(opt_.histogram_value_rounds) * ((value_sample() + kValueChunk - 1) / kValueChunk);
+  }
 
  private:
   struct View {
@@ -99,6 +105,39 @@ class LevelSolver {
   void histogram_factors(const std::vector<std::int64_t>& counts, const std::vector<double>& target,
                          OptimizeTables& tables) const;
   bool blend_voxel(const int p[3], const OptimizeTables& tables, VoxelScratch& scratch) const;
+  // Histogram-matched exemplar values (level_solver.cpp, discrete_histogram).
+  // Per distinct exemplar: per pixel its kValueBins bin of each value
+  // channel and its price factor; the target histogram (fractions per
+  // channel and bin) and the views' exemplar tables.
+  struct ValueTables {
+    int channels = 0;                                // value channels (the feature channel is not matched)
+    std::vector<const ExemplarIndex*> ex;            // distinct exemplars
+    std::vector<std::vector<std::uint8_t>> bins;     // per exemplar: pixel * channels + c
+    std::vector<std::vector<float>> factor;          // per exemplar: per pixel exp((1 - beta) x its price)
+    std::vector<std::vector<float>> window;          // per exemplar: per window corner exp(beta x mean price)
+    std::array<int, 3> of{-1, -1, -1};               // per view: its exemplar's tables
+    std::vector<double> target;                      // channels * kValueBins fractions
+  };
+  // One covering window's proposal for a voxel: the view and the exemplar
+  // pixel it puts there, and the window's IRLS weight.
+  struct Proposal {
+    int view;
+    std::size_t corner, pix;  // the window's top-left exemplar pixel, the texel's
+    float weight;
+  };
+  struct Choice {
+    int view = -1;  // -1: no window covers the voxel
+    std::size_t pix = 0;
+  };
+  static constexpr std::size_t kValueSample = std::size_t(1) << 15;  // voxels the pricing rounds count
+  static constexpr std::size_t kValueChunk = 1024;                   // of them per parallel chunk
+  std::size_t value_sample() const;
+  ValueTables value_tables() const;
+  void price_factors(const std::vector<double>& price, ValueTables& vt) const;
+  Choice choose_value(const int p[3], const ValueTables& vt, std::vector<Proposal>& proposals) const;
+  std::vector<std::int64_t> chosen_histogram(const ValueTables& vt, StageProgress& progress) const;
+  void write_values(const ValueTables& vt, StageProgress& progress, std::vector<std::int32_t>* source);
+  void discrete_histogram(StageProgress& progress, std::vector<std::int32_t>* source);
   // Voxel (x, y, z)'s values pulled towards the constraint's targets by its weight.
   void constrain(int x, int y, int z, float* values) const {
     if (constraint_.empty()) return;

@@ -42,6 +42,9 @@ void check_options(const TextureOptimizationOptions& o) {
   range("histogram_bins", o.histogram_bins, 2, 256, "");
   range("histogram_strength", o.histogram_strength, 0, 16, " (1 = the gentle weighting, 3 = default)");
   range("feature_weight", o.feature_weight, 0, 100, " (0 = off)");
+  range("histogram_values", o.histogram_values, 0, 100, " (0 = off)");
+  range("histogram_value_rounds", o.histogram_value_rounds, 1, 64, "");
+  range("histogram_value_window", o.histogram_value_window, 0, 1, " (0 = each texel's own price)");
   if (o.max_exemplar_size != 0) range("max_exemplar_size", o.max_exemplar_size, o.neighborhood, 1 << 16, " pixels (0 = full resolution)");
 }
 
