@@ -60,7 +60,7 @@ double histogram_distance(const std::vector<std::int64_t>& counts, const std::ve
 // output keeps, so it is not matched.
 LevelSolver::ValueTables LevelSolver::value_tables() const {
   ValueTables vt;
-  vt.channels = C_ - (opt_.feature_weight > 0 ? 1 : 0);
+  vt.channels = H_;  // the histogram-matched channels (the feature channel, when present, is the last)
   const int V = vt.channels;
   vt.target.assign(std::size_t(V) * kValueBins, 0.0);
   int active = 0;
