@@ -60,7 +60,7 @@ class LevelSolver {
   std::size_t discrete_units() const {
     const std::size_t rows = std::size_t(tex_.ny()) * tex_.nz();
     if (opt_.histogram_values <= 0) return rows;
-    return rows + std::size_t(opt_.histogram_value_rounds) * ((value_sample() + kValueChunk - 1) / kValueChunk);
+    return 2 * rows + std::size_t(opt_.histogram_value_rounds) * ((value_sample() + kValueChunk - 1) / kValueChunk);
   }
 
  private:
@@ -134,7 +134,10 @@ class LevelSolver {
   std::size_t value_sample() const;
   ValueTables value_tables() const;
   void price_factors(const std::vector<double>& price, ValueTables& vt) const;
-  Choice choose_value(const int p[3], const ValueTables& vt, std::vector<Proposal>& proposals) const;
+  // The priced choice; `plain`, when given, receives the unpriced one (the plain pass's).
+  Choice choose_value(const int p[3], const ValueTables& vt, std::vector<Proposal>& proposals,
+                      Choice* plain = nullptr) const;
+  bool coherent_choice(const int p[3], std::int32_t code, const std::vector<std::int32_t>& chosen) const;
   std::vector<std::int64_t> chosen_histogram(const ValueTables& vt, StageProgress& progress) const;
   void write_values(const ValueTables& vt, StageProgress& progress, std::vector<std::int32_t>* source);
   void discrete_histogram(StageProgress& progress, std::vector<std::int32_t>* source);
