@@ -260,7 +260,8 @@ void LevelSolver::write_values(const ValueTables& vt, StageProgress& progress, s
       }
     }
   });
-  std::vector<std::int32_t> kept(chosen.size());
+  // plain[v] becomes v's final choice: each voxel reads only its own entry of
+  // plain, and its neighbours' of chosen.
   parallel_chunks(rows, 1, progress, [&](std::size_t r0, std::size_t r1) {
     for (std::size_t row = r0; row < r1; ++row) {
       const int y = int(row % std::size_t(dims[1])), z = int(row / std::size_t(dims[1]));
@@ -268,17 +269,17 @@ void LevelSolver::write_values(const ValueTables& vt, StageProgress& progress, s
         const int p[3] = {x, y, z};
         const std::size_t v = tex_.voxel_index(x, y, z);
         const std::int32_t code = chosen[v];
-        kept[v] = code == plain[v] || coherent_choice(p, code, chosen) ? code : plain[v];
-        if (kept[v] < 0) continue;  // no window covers p: keep the optimised value
-        const int view = int(kept[v] >> 28);
+        if (code != plain[v] && coherent_choice(p, code, chosen)) plain[v] = code;
+        const std::int32_t kept = plain[v];
+        if (kept < 0) continue;  // no window covers p: keep the optimised value
         float* out = tex_.data() + tex_.offset(x, y, z);
-        const float* e = views_[view].ex->image().data() + std::size_t(kept[v] & ((1 << 28) - 1)) * C_;
+        const float* e = views_[kept >> 28].ex->image().data() + std::size_t(kept & ((1 << 28) - 1)) * C_;
         std::copy(e, e + C_, out);
         constrain(x, y, z, out);
       }
     }
   });
-  chosen.swap(kept);
+  chosen.swap(plain);
 }
 
 void LevelSolver::discrete_histogram(StageProgress& progress, std::vector<std::int32_t>* source) {
