@@ -131,24 +131,12 @@ LevelSolver::Choice LevelSolver::choose_value(const int p[3], const ValueTables&
   proposals.clear();
   float support[3] = {0.0f, 0.0f, 0.0f}, best[3] = {0.0f, 0.0f, 0.0f};
   for (int i = 0; i < 3; ++i) {
-    const View& w = views_[i];
-    if (!w.ex) continue;
-    const SliceAxes& s = kSlices[i];
-    const int width = w.ex->image().width();
-    const Covering cov = cover(p, s);
-    for (int a = 0; a < cov.nv; ++a) {
-      const std::size_t row_sp = (std::size_t(p[s.axis]) * w.nv + cov.sv[a]) * w.nu;
-      for (int b = 0; b < cov.nu; ++b) {
-        const std::size_t sp = row_sp + cov.su[b];
-        const int j = w.match[sp];
-        if (j < 0) continue;
-        const float wt = w.weight[sp];
-        support[i] += wt;
-        best[i] = std::max(best[i], wt);
-        const std::size_t corner = std::size_t(w.ex->centre_v(j) - lo_) * width + (w.ex->centre_u(j) - lo_);
-        proposals.push_back({i, corner, corner + std::size_t(cov.dv[a]) * width + cov.du[b], wt});
-      }
-    }
+    if (!views_[i].ex) continue;
+    for_each_covering(p, i, [&](float wt, std::size_t corner, std::size_t pix) {
+      support[i] += wt;
+      best[i] = std::max(best[i], wt);
+      proposals.push_back({i, corner, pix, wt});
+    });
   }
   Choice choice;
   double best_score = -1.0, best_plain = -1.0;
@@ -205,16 +193,12 @@ std::vector<std::int64_t> LevelSolver::chosen_histogram(const ValueTables& vt, S
   return counts;
 }
 
-namespace {
-std::int32_t source_code(int view, std::size_t pix) { return view < 0 ? -1 : std::int32_t((std::size_t(view) << 28) | pix); }
-}  // namespace
-
 // Whether choice `code` of voxel p continues a neighbour's: one of its four
 // neighbours in the chosen view's slice plane chose, in the same view, the
 // exemplar texel next to p's in that direction (a piece of >= 2 voxels).
 bool LevelSolver::coherent_choice(const int p[3], std::int32_t code, const std::vector<std::int32_t>& chosen) const {
-  const int view = int(code >> 28);
-  const std::size_t pix = std::size_t(code & ((1 << 28) - 1));
+  const int view = source_view(code);
+  const std::size_t pix = source_pixel(code);
   const SliceAxes& s = kSlices[view];
   const Image& img = views_[view].ex->image();
   const std::size_t width = std::size_t(img.width()), height = std::size_t(img.height());
@@ -273,7 +257,7 @@ void LevelSolver::write_values(const ValueTables& vt, StageProgress& progress, s
         const std::int32_t kept = plain[v];
         if (kept < 0) continue;  // no window covers p: keep the optimised value
         float* out = tex_.data() + tex_.offset(x, y, z);
-        const float* e = views_[kept >> 28].ex->image().data() + std::size_t(kept & ((1 << 28) - 1)) * C_;
+        const float* e = views_[source_view(kept)].ex->image().data() + source_pixel(kept) * C_;
         std::copy(e, e + C_, out);
         constrain(x, y, z, out);
       }
