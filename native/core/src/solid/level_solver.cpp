@@ -563,6 +563,10 @@ namespace exsynth::solid {
 // choice is independent of the others, so any thread count gives the same.
 void LevelSolver::discrete(StageProgress& progress, std::vector<std::int32_t>* source) {
   if (opt_.histogram_values > 0) return discrete_histogram(progress, source);  // histogram_values.cpp
+  plain_values(progress, source);
+}
+
+void LevelSolver::plain_values(StageProgress& progress, std::vector<std::int32_t>* source) {
   const int dims[3] = {tex_.nx(), tex_.ny(), tex_.nz()};
   if (source) source->assign(tex_.voxel_count(), -1);
   // Rows of voxels (y, z) in parallel: an image is a single z-slice.

@@ -141,6 +141,8 @@ class LevelSolver {
   std::vector<std::int64_t> chosen_histogram(const ValueTables& vt, StageProgress& progress) const;
   void write_values(const ValueTables& vt, StageProgress& progress, std::vector<std::int32_t>* source);
   void discrete_histogram(StageProgress& progress, std::vector<std::int32_t>* source);
+  void plain_values(StageProgress& progress, std::vector<std::int32_t>* source);  // discrete's plain pass
+  static constexpr int kValuePatience = 8;  // rounds with no nearer histogram before the pricing stops
   // TextureResult::source's code of a voxel's choice: view * 2^28 + exemplar
   // pixel; -1 = none (no window covers the voxel).
   static std::int32_t source_code(int view, std::size_t pix) {
