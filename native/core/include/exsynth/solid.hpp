@@ -55,9 +55,9 @@ constexpr double kSolidFeatureWeight = 2.0;
 /// Solids' histogram_values (SolidOptions): the exemplar values match the
 /// exemplars' histogram. On 64^3 slices of 8 exemplars it changes only those
 /// whose plain values miss the histogram (stone33: contrast 0.76 -> 0.89,
-/// hist_emd 10.8 -> 7.3; brick, brownground), for ~20 % more time at 128^3;
-/// the others' nearest round is the plain pass (docs/solid.md, eleventh pass).
-/// Steps of 0.5 and more oscillate.
+/// hist_emd 10.8 -> 7.3; brick, brownground), for 12-24 % more time at 128^3
+/// there; the others' nearest round is the plain pass, which then writes at
+/// its own cost (docs/solid.md, eleventh pass). Steps of 0.5 and more oscillate.
 constexpr double kSolidHistogramValues = 0.3;
 
 /// Bins per value channel of TextureOptimizationOptions::histogram_values
