@@ -7,7 +7,8 @@ Blender with the add-on's method set, at a larger resolution so the
 texture's structure can be judged, and writes OUT.png.
 
 usage: blender -b --factory-startup --python bench/figure_solid_cow.py -- \\
-           --build build --out OUT.png [--method coordinates] [--size 64] [--samples 16] [--resolution 960 720]
+           --build build --out OUT.png [--method coordinates] [--size 64] [--samples 16] [--resolution 960 720] \\
+           [--exemplar IMAGE.png]
 """
 import argparse
 import os
@@ -20,6 +21,7 @@ def main(argv):
     ap.add_argument("--out", required=True)
     ap.add_argument("--method", default=None, help="a SOLID_METHODS name (default: the add-on's)")
     ap.add_argument("--size", type=int, default=64)
+    ap.add_argument("--exemplar", default=None, help="an image Blender reads (default: the demo's crackedground.png)")
     ap.add_argument("--options", default="",
                     help="extra engine options for the solid, e.g. \"finest_iterations=1\" "
                          "(a developer's experiment: wraps _native.synthesize_solid)")
@@ -38,7 +40,7 @@ def main(argv):
     root = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
     out = os.path.abspath(args.out)
     return demo.run_solid(os.path.join(root, "assets", "meshes", "cow.obj"),
-                          os.path.join(root, "assets", "textures", "crackedground.png"),
+                          os.path.abspath(args.exemplar or os.path.join(root, "assets", "textures", "crackedground.png")),
                           os.path.dirname(out), size=args.size, samples=args.samples, method=args.method,
                           name=os.path.basename(out))
 

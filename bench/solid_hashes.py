@@ -27,6 +27,8 @@ cases = [
     ("solid32_kdtree", lambda: _native.synthesize_solid(ex, size=32, seed=8, search="kdtree")),
     ("solid32_hist1", lambda: _native.synthesize_solid(ex, size=32, seed=9, histogram_strength=1.0, coherent_upsampling=False)),
     ("solid32_feature", lambda: _native.synthesize_solid(ex, size=32, seed=10, feature_weight=1.0)),
+    ("solid48_plainvalues", lambda: _native.synthesize_solid(ex, size=48, seed=11, histogram_values=0)),
+    ("solid48_histvalues", lambda: _native.synthesize_solid(ex, size=48, seed=12, histogram_values=0.1, histogram_value_window=0.5)),
     ("image128_opt", lambda: _native.synthesize_image(ex, width=128, height=128, seed=1, method="optimization")),
     ("image96_opt_tile", lambda: _native.synthesize_image(ex, width=96, height=80, seed=2, method="optimization", tileable=True)),
     ("coord64", lambda: _native.synthesize_solid(ex, size=64, seed=1, method="coordinates")),

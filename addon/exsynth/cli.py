@@ -178,6 +178,9 @@ def _parser():
     p.add_argument("--feature-weight", type=_finite, default=_native.SOLID_DEFAULT_FEATURE_WEIGHT,
                    help="with --method optimization: weight of the distance to the exemplar's dark features "
                    "(cracks, mortar) in the matching; higher = crisper, 0 = colours only (default %(default)s)")
+    p.add_argument("--histogram-values", type=_finite, default=_native.SOLID_DEFAULT_HISTOGRAM_VALUES,
+                   help="with --method optimization: how strongly each voxel's exemplar colour is picked to match "
+                   "the exemplar's histogram (contrast); above 0.5 it oscillates, 0 = off (default %(default)s)")
     p.add_argument("--seed", type=_seed, default=0, help="random seed (default 0)")
     p.add_argument("--alpha", action="store_true", help="synthesize the exemplars' alpha as a 4th channel")
     p.add_argument("--scale", type=_finite, default=0.0,
@@ -503,6 +506,8 @@ def _run_solid(args):
     _texture_size("--size", (args.size,), args.levels, _native.SOLID_MAX_SIZE, "voxels")
     _require(args.iterations > 0, f"--iterations must be > 0 (got {args.iterations})")
     _require(args.feature_weight >= 0, f"--feature-weight must be >= 0 (got {args.feature_weight}); 0 = off")
+    _require(args.histogram_values >= 0,
+             f"--histogram-values must be >= 0 (got {args.histogram_values}); 0 = off")
     _require(args.scale >= 0, f"--scale must be >= 0 (got {args.scale}); 0 picks it from the mesh")
     _require(args.memory_budget >= 0, f"--memory-budget must be >= 0 GiB (got {args.memory_budget})")
     _require(bool(args.mesh) == bool(args.bake_out), "--mesh and --bake-out go together")
@@ -524,7 +529,8 @@ def _run_solid(args):
     job = solid_ops.SolidJob(
         name=solid_ops.exemplar_name(images[0]), exemplar=exemplar, exemplar_y=exemplar_y,
         exemplar_z=exemplar_z, size=args.size, levels=args.levels, iterations=args.iterations,
-        method=args.method, feature_weight=args.feature_weight, scale=scale, seed=args.seed,
+        method=args.method, feature_weight=args.feature_weight, histogram_values=args.histogram_values,
+        scale=scale, seed=args.seed,
         memory_budget=int(args.memory_budget * GIB), encoding=encoding,
         anchor=anchor, targets=targets, bake=solid_ops.BakeOptions(args.bake_size),
     )

@@ -135,6 +135,14 @@ class ExSynthSettings(bpy.types.PropertyGroup):
         "only. The Coordinates method ignores it",
         default=_native.SOLID_DEFAULT_FEATURE_WEIGHT, min=0.0, max=100.0, soft_max=8.0,
     )
+    solid_histogram_values: FloatProperty(
+        name="Histogram Values",
+        description="How strongly the Optimization method picks each voxel's exemplar colour so that the solid "
+        "has the exemplar's share of dark and light (cracks, mortar, light stones): higher matches contrast "
+        "closer, above 0.5 it oscillates; 0 = each voxel takes its best-matching window's colour. The "
+        "Coordinates method ignores it",
+        default=_native.SOLID_DEFAULT_HISTOGRAM_VALUES, min=0.0, max=100.0, soft_max=1.0,
+    )
     solid_scale: FloatProperty(
         name="Scale",
         description="Edge length of one tile of the solid, in the units of the solid's Volume object "

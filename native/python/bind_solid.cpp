@@ -156,7 +156,7 @@ const std::string& image_doc() {
            std::to_string(d.cut_radius) + ", cut_matches=" + flag(d.cut_matches) +
            "; also tileable, max_exemplar_size, seed.\nmethod='optimization': the optimiser of synthesize_solid, "
            "same options (feature_weight=" + format_number(ImageSynthesisOptions{}.feature_weight) +
-           " here). Returns {'image': ..., 'energy': [...]}.";
+           ", histogram_values=" + format_number(ImageSynthesisOptions{}.histogram_values) + " here). Returns {'image': ..., 'energy': [...]}.";
   }();
   return doc;
 }
@@ -178,6 +178,7 @@ void bind_solid(py::module_& m) {
   m.attr("DEFAULT_ITERATIONS") = TextureOptimizationOptions{}.iterations;
   m.attr("SOLID_DEFAULT_SIZE") = SolidOptions{}.size;
   m.attr("SOLID_DEFAULT_FEATURE_WEIGHT") = SolidOptions{}.feature_weight;
+  m.attr("SOLID_DEFAULT_HISTOGRAM_VALUES") = SolidOptions{}.histogram_values;
   m.attr("SOLID_MAX_SIZE") = kMaxSolidSize;
   m.attr("IMAGE_MAX_SIZE") = kMaxImageSize;
   m.attr("DEFAULT_MAX_EXEMPLAR_SIZE") = kDefaultMaxExemplarSize;
@@ -232,14 +233,14 @@ target values then a weight in [0, 1]. Options (keywords): levels=3, neighborhoo
 iterations=3, finest_iterations=-1 (rounds at the finest level; 0 = iterations; -1 = 2 from 64 voxels across), r=0.8, pca_variance=0.95, max_pca_dims=32,
 search='kcoherence'|'kdtree'|'exact', coherence_k=4, random_candidates=2, ann_eps=2.0, histogram_matching=True, histogram_bins=16, histogram_strength=3
 ((1 + excess)^-strength re-weighting; 1 = gentle),
-mean_shift=False, coherent_upsampling=True, exemplar_values=True, histogram_values=0 (> 0: the exemplar values
-match the exemplars' histogram, this being the step of the per-bin prices; 0 = off), histogram_value_rounds=32
+mean_shift=False, coherent_upsampling=True, exemplar_values=True, histogram_values=SOLID_DEFAULT_HISTOGRAM_VALUES (> 0: the
+exemplar values match the exemplars' histogram, this being the step of the per-bin prices; 0 = off), histogram_value_rounds=32
 (its pricing rounds), histogram_value_window=0 (0..1: the share of a proposal's price taken from its whole
 window's texels, for coherent choices), feature_weight=SOLID_DEFAULT_FEATURE_WEIGHT (the feature-distance channel's weight; 0 = off), tileable=True,
 max_exemplar_size=256 (working resolution: larger exemplars are halved until they fit; 0 = never),
 method=SOLID_DEFAULT_METHOD ('optimization': Kopf et al. 2007; 'coordinates': exemplar coordinates after
-Dong et al. 2008, which uses levels, iterations, finest_iterations, coordinate_coherence_k=1 (0..16), pca_variance, max_pca_dims,
-max_exemplar_size, tileable, memory_budget and seed (feature_weight does not apply), and takes no constraint),
+Dong et al. 2008, which uses levels, iterations, finest_iterations, coordinate_coherence_k=0 (0..16), pca_variance, max_pca_dims,
+max_exemplar_size, tileable, memory_budget and seed (feature_weight and histogram_values do not apply), and takes no constraint),
 memory_budget=0 (default), seed=0. size: min_texture_size(levels, neighborhood) .. SOLID_MAX_SIZE.
 Returns {'solid': (Z, Y, X, C) float32, 'energy': [...], 'energy_level': [...]}.)doc");
 

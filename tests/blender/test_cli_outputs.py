@@ -11,7 +11,9 @@ import subprocess
 import numpy as np
 import pytest
 
-from exsynth import cli
+from exsynth import _native, cli
+from exsynth.io import image as image_io
+from exsynth.operators import solid as solid_ops
 from helpers import BUNNY_OBJ, ROOT, TEXTURES
 
 CRACKED = os.path.join(TEXTURES, "crackedground.png")
@@ -157,6 +159,21 @@ def test_solid_feature_weight(tmp_path, capsys):
     assert plain.shape == featured.shape == (16, 16, 16, 3) and not np.array_equal(plain, featured)
     for weight, message in (("-1", "--feature-weight must be >= 0 (got -1.0)"), ("101", "feature_weight")):
         code, err = run(capsys, "solid", "--exemplar", CRACKED, *FAST_SOLID, "--feature-weight", weight,
+                        "--out", str(tmp_path / "bad.npy"))
+        assert code != 0 and message in err, err
+    assert not (tmp_path / "bad.npy").exists()
+
+
+def test_solid_histogram_values(tmp_path, capsys):
+    out = tmp_path / "h.npy"
+    code, err = run(capsys, "solid", "--exemplar", CRACKED, "--size", "16", "--levels", "2", "--iterations", "1",
+                    "--histogram-values", "0.1", "--out", str(out))
+    assert code == 0, err
+    ex = solid_ops.read_exemplars(image_io.load(CRACKED))[0]
+    direct = _native.synthesize_solid(ex, size=16, levels=2, iterations=1, seed=0, histogram_values=0.1)["solid"]
+    np.testing.assert_allclose(np.load(out), direct, atol=1e-6)
+    for value, message in (("-1", "--histogram-values must be >= 0 (got -1.0)"), ("101", "histogram_values")):
+        code, err = run(capsys, "solid", "--exemplar", CRACKED, *FAST_SOLID, "--histogram-values", value,
                         "--out", str(tmp_path / "bad.npy"))
         assert code != 0 and message in err, err
     assert not (tmp_path / "bad.npy").exists()

@@ -649,6 +649,20 @@ def test_coordinates_method_refuses_an_exemplar_too_small_for_its_levels(cow, ex
     run_expecting_error("too small for method 'coordinates'", objects=[cow])
 
 
+# ---- histogram values (the optimiser's histogram-matched exemplar values) ----------------------
+def test_histogram_values_default_to_the_engines_and_reach_it(cow, exemplar):
+    assert settings().solid_histogram_values == pytest.approx(_native.SOLID_DEFAULT_HISTOGRAM_VALUES)
+    assert _native.SOLID_DEFAULT_HISTOGRAM_VALUES > 0
+    settings().solid_histogram_values = 0.1
+    assert run() == {'FINISHED'}
+    made, _, _ = read_solid(bpy.data.objects["crackedground_solid"])
+    ex = solid_ops.read_exemplars(exemplar)[0]
+    direct = lambda **kw: _native.synthesize_solid(ex, size=16, levels=2, iterations=2, seed=settings().seed,
+                                                   method="optimization", **kw)["solid"]
+    np.testing.assert_allclose(made, direct(histogram_values=0.1), atol=1e-6)
+    assert not np.array_equal(direct(histogram_values=0.1), direct(histogram_values=0.0))  # the value matters here
+
+
 # ---- feature weight (the optimiser's feature-distance channel) --------------------------------
 def test_feature_weight_defaults_to_the_engines_and_reaches_it(cow, exemplar):
     assert settings().solid_feature_weight == pytest.approx(_native.SOLID_DEFAULT_FEATURE_WEIGHT)

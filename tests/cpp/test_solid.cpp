@@ -32,6 +32,14 @@ SolidOptions small_options() {
   return o;
 }
 
+// The plain exemplar-values pass (each voxel: its best window's texel; the
+// solids' default matches the histogram on top, histogram_values).
+SolidOptions plain_values_options() {
+  SolidOptions o = small_options();
+  o.histogram_values = 0.0;
+  return o;
+}
+
 // Mean over n sampled 8x8 windows of a slice of their distance to the
 // nearest exemplar window (brute force): how much a slice looks like the exemplar.
 double slice_to_exemplar_distance(const Volume& v, int axis, const Image& ex, int samples = 40) {
@@ -413,6 +421,7 @@ TEST(Image2D, SynthesisesTheRequestedSizeAndTiles) {
 #include "solid/candidate_scoring.hpp"
 #include "solid/exemplar_index.hpp"
 #include "solid/feature_channel.hpp"
+#include "solid/level_solver.hpp"
 
 // The k-coherence sets from the k-d tree (approximate: a tree over half the
 // windows in leading PCA dimensions, re-ranked) against the brute force over
@@ -609,9 +618,11 @@ TEST(Solid, FeatureChannelWorksWithAConstraint) {
 // Exemplar values (the final discrete pass): every output value is an
 // exemplar texel, exactly the one the reported source names, and the
 // discrete output resembles the exemplar at least as well as the average.
+// (The plain pass: with histogram_values 0.3 the slice distance here is
+// 1.26x the average's, the price of the histogram.)
 TEST(Solid, ExemplarValuesAreTheExemplarsTexelsAtTheirSource) {
   const Image ex = disc_texture(32, 32, 3, 21);
-  const TextureResult r = synthesize_solid(one_exemplar(ex), small_options());
+  const TextureResult r = synthesize_solid(one_exemplar(ex), plain_values_options());
   ASSERT_EQ(r.source.size(), r.texture.voxel_count());
   for (std::size_t v = 0; v < r.texture.voxel_count(); ++v) {
     ASSERT_GE(r.source[v], 0) << "voxel " << v << " was not covered by any window";
@@ -625,7 +636,7 @@ TEST(Solid, ExemplarValuesAreTheExemplarsTexelsAtTheirSource) {
   for (std::int32_t s : r.source) ++per_view[s >> 28];
   for (int i = 0; i < 3; ++i) EXPECT_GT(per_view[i], int(r.source.size() / 10)) << "view " << i;
 
-  SolidOptions averaged = small_options();
+  SolidOptions averaged = plain_values_options();
   averaged.exemplar_values = false;
   const TextureResult a = synthesize_solid(one_exemplar(ex), averaged);
   EXPECT_TRUE(a.source.empty());
@@ -713,11 +724,17 @@ TEST(Solid, HistogramValuesAreTheExemplarsTexelsAtTheirSource) {
   }
 }
 
+TEST(Solid, SolidsDefaultToHistogramValues) {
+  EXPECT_EQ(SolidOptions{}.histogram_values, kSolidHistogramValues);
+  EXPECT_GT(kSolidHistogramValues, 0.0);
+  EXPECT_EQ(ImageSynthesisOptions{}.histogram_values, 0.0);  // images: the coordinates method's
+}
+
 // The point of the option: the solid's histogram comes closer to the
 // exemplar's than the plain pass's (which round 0 reproduces).
 TEST(Solid, HistogramValuesBringTheHistogramCloser) {
   const Image ex = contrasty_exemplar();
-  SolidOptions plain = small_options();
+  const SolidOptions plain = plain_values_options();
   const double before = histogram_emd(synthesize_solid(one_exemplar(ex), plain).texture, ex);
   const double after = histogram_emd(synthesize_solid(one_exemplar(ex), histogram_values_options()).texture, ex);
   EXPECT_LT(after, 0.8 * before) << "plain " << before << ", histogram-matched " << after;
@@ -729,9 +746,43 @@ TEST(Solid, HistogramValuesWithOneRoundAreThePlainPass) {
   SolidOptions one_round = histogram_values_options();
   one_round.histogram_value_rounds = 1;
   const TextureResult a = synthesize_solid(one_exemplar(ex), one_round);
-  const TextureResult b = synthesize_solid(one_exemplar(ex), small_options());
+  const TextureResult b = synthesize_solid(one_exemplar(ex), plain_values_options());
   EXPECT_EQ(a.texture.values(), b.texture.values());
   EXPECT_EQ(a.source, b.source);
+}
+
+// No speckle: a voxel whose texel differs from the plain pass's continues a
+// neighbour's piece of exemplar, i.e. one of its four neighbours in its
+// view's slice plane took, in that view, the texel next to its own.
+TEST(Solid, HistogramValuesChangeOnlyPiecesOfExemplar) {
+  const Image ex = contrasty_exemplar();
+  const SolidOptions o = histogram_values_options();
+  const TextureResult plain = synthesize_solid(one_exemplar(ex), plain_values_options());
+  const TextureResult r = synthesize_solid(one_exemplar(ex), o);
+  const int n = o.size, W = ex.width(), H = ex.height();
+  auto index = [&](int x, int y, int z) { return (std::size_t(z) * n + y) * n + x; };
+  int changed = 0;
+  for (int z = 0; z < n; ++z)
+    for (int y = 0; y < n; ++y)
+      for (int x = 0; x < n; ++x) {
+        const std::int32_t code = r.source[index(x, y, z)];
+        if (code == plain.source[index(x, y, z)]) continue;
+        ++changed;
+        const int view = code >> 28, pix = code & ((1 << 28) - 1), col = pix % W, row = pix / W;
+        const solid::SliceAxes& s = solid::kSlices[view];
+        bool continued = false;
+        for (int axis : {s.u, s.v})
+          for (int step : {-1, 1}) {
+            const int along = axis == s.u ? col : row, edge = axis == s.u ? W : H;
+            if (along + step < 0 || along + step >= edge) continue;
+            int q[3] = {x, y, z};
+            q[axis] = (q[axis] + step + n) % n;  // the solid tiles
+            const int next = axis == s.u ? pix + step : pix + step * W;
+            continued = continued || r.source[index(q[0], q[1], q[2])] == ((view << 28) | next);
+          }
+        ASSERT_TRUE(continued) << "voxel " << x << " " << y << " " << z << " is a lone changed texel";
+      }
+  EXPECT_GT(changed, int(r.source.size() / 50));  // the prices did change choices
 }
 
 TEST(Solid, HistogramValuesSameOnOneTwoAndEightThreads) {

@@ -370,12 +370,13 @@ def test_histogram_values_match_the_exemplars_histogram_with_its_texels():
     ex = exemplar("granite1.png", size=48)
     palette = {tuple(p) for p in ex.reshape(-1, 3).tolist()}
     flat = lambda s: np.rint(s.reshape(-1, 3) * 255.0).astype(int)
-    plain = optimizer_solid(ex, size=32, levels=2, seed=7)["solid"]
-    matched = optimizer_solid(ex, size=32, levels=2, seed=7, histogram_values=0.3)["solid"]
+    plain = optimizer_solid(ex, size=32, levels=2, seed=7, histogram_values=0)["solid"]
+    matched = optimizer_solid(ex, size=32, levels=2, seed=7)["solid"]  # the default's
+    assert _native.SOLID_DEFAULT_HISTOGRAM_VALUES > 0
     assert all(tuple(t) in palette for t in flat(matched).tolist())
     before = quality.hist_emd(ex.astype(np.float64), flat(plain).astype(np.float64))
     after = quality.hist_emd(ex.astype(np.float64), flat(matched).astype(np.float64))
-    assert after < 0.8 * before, (before, after)  # measured 3.16 -> 2.22 (seed 7)
+    assert after < 0.8 * before, (before, after)  # measured 3.16 -> 2.18 (seed 7)
 
 
 def test_quality_metrics_on_known_cases():

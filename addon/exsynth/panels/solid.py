@@ -79,9 +79,10 @@ class EXSYNTH_PT_solid_advanced(SidebarPanel, bpy.types.Panel):
         layout = self._layout()
         settings = context.scene.exsynth
         layout.prop(settings, "solid_method")
-        row = layout.row()
-        row.active = settings.solid_method == 'OPTIMIZATION'  # the other method ignores it
-        row.prop(settings, "solid_feature_weight")
+        col = layout.column()
+        col.active = settings.solid_method == 'OPTIMIZATION'  # the other method ignores them
+        col.prop(settings, "solid_feature_weight")
+        col.prop(settings, "solid_histogram_values")
         draw_shared_advanced(layout, context.scene.exsynth)
 
 

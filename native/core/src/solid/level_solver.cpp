@@ -563,6 +563,10 @@ namespace exsynth::solid {
 // choice is independent of the others, so any thread count gives the same.
 void LevelSolver::discrete(StageProgress& progress, std::vector<std::int32_t>* source) {
   if (opt_.histogram_values > 0) return discrete_histogram(progress, source);  // histogram_values.cpp
+  plain_values(progress, source);
+}
+
+void LevelSolver::plain_values(StageProgress& progress, std::vector<std::int32_t>* source) {
   const int dims[3] = {tex_.nx(), tex_.ny(), tex_.nz()};
   if (source) source->assign(tex_.voxel_count(), -1);
   // Rows of voxels (y, z) in parallel: an image is a single z-slice.
@@ -575,26 +579,15 @@ void LevelSolver::discrete(StageProgress& progress, std::vector<std::int32_t>* s
         std::size_t best_pix = 0;
         float best_support = -1.0f;
         for (int i = 0; i < 3; ++i) {
-          const View& w = views_[i];
-          if (!w.ex) continue;
-          const SliceAxes& s = kSlices[i];
-          const int width = w.ex->image().width();
+          if (!views_[i].ex) continue;
           float best_weight = -1.0f, support = 0.0f;
           std::size_t pix = 0;
-          const Covering cov = cover(p, s);
-          for (int a = 0; a < cov.nv; ++a) {
-            const std::size_t row_sp = (std::size_t(p[s.axis]) * w.nv + cov.sv[a]) * w.nu;
-            for (int b = 0; b < cov.nu; ++b) {
-              const std::size_t sp = row_sp + cov.su[b];
-              const int j = w.match[sp];
-              if (j < 0) continue;
-              const float wt = w.weight[sp];
-              support += wt;
-              if (wt <= best_weight) continue;  // ties: the first in scan order
-              best_weight = wt;
-              pix = std::size_t(w.ex->centre_v(j) - lo_ + cov.dv[a]) * width + (w.ex->centre_u(j) - lo_ + cov.du[b]);
-            }
-          }
+          for_each_covering(p, i, [&](float wt, std::size_t, std::size_t texel) {
+            support += wt;
+            if (wt <= best_weight) return;  // ties: the first in scan order
+            best_weight = wt;
+            pix = texel;
+          });
           if (best_weight >= 0.0f && support > best_support) best_support = support, best_view = i, best_pix = pix;
         }
         if (best_view < 0) continue;  // no window covers p: keep the optimised value
@@ -602,7 +595,7 @@ void LevelSolver::discrete(StageProgress& progress, std::vector<std::int32_t>* s
         const float* e = views_[best_view].ex->image().data() + best_pix * C_;
         std::copy(e, e + C_, out);
         constrain(x, y, z, out);  // a requested target still wins by its weight
-        if (source) (*source)[tex_.voxel_index(x, y, z)] = std::int32_t((std::size_t(best_view) << 28) | best_pix);
+        if (source) (*source)[tex_.voxel_index(x, y, z)] = source_code(best_view, best_pix);
       }
     }
   });

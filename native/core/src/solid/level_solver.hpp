@@ -60,7 +60,7 @@ class LevelSolver {
   std::size_t discrete_units() const {
     const std::size_t rows = std::size_t(tex_.ny()) * tex_.nz();
     if (opt_.histogram_values <= 0) return rows;
-    return rows + std::size_t(opt_.histogram_value_rounds) * ((value_sample() + kValueChunk - 1) / kValueChunk);
+    return 2 * rows + std::size_t(opt_.histogram_value_rounds) * ((value_sample() + kValueChunk - 1) / kValueChunk);
   }
 
  private:
@@ -134,10 +134,42 @@ class LevelSolver {
   std::size_t value_sample() const;
   ValueTables value_tables() const;
   void price_factors(const std::vector<double>& price, ValueTables& vt) const;
-  Choice choose_value(const int p[3], const ValueTables& vt, std::vector<Proposal>& proposals) const;
+  // The priced choice; `plain`, when given, receives the unpriced one (the plain pass's).
+  Choice choose_value(const int p[3], const ValueTables& vt, std::vector<Proposal>& proposals,
+                      Choice* plain = nullptr) const;
+  bool coherent_choice(const int p[3], std::int32_t code, const std::vector<std::int32_t>& chosen) const;
   std::vector<std::int64_t> chosen_histogram(const ValueTables& vt, StageProgress& progress) const;
   void write_values(const ValueTables& vt, StageProgress& progress, std::vector<std::int32_t>* source);
   void discrete_histogram(StageProgress& progress, std::vector<std::int32_t>* source);
+  void plain_values(StageProgress& progress, std::vector<std::int32_t>* source);  // discrete's plain pass
+  static constexpr int kValuePatience = 8;  // rounds with no nearer histogram before the pricing stops
+  // TextureResult::source's code of a voxel's choice: view * 2^28 + exemplar
+  // pixel; -1 = none (no window covers the voxel).
+  static std::int32_t source_code(int view, std::size_t pix) {
+    return view < 0 ? -1 : std::int32_t((std::size_t(view) << 28) | pix);
+  }
+  static int source_view(std::int32_t code) { return int(code >> 28); }
+  static std::size_t source_pixel(std::int32_t code) { return std::size_t(code & ((1 << 28) - 1)); }
+  // fn(weight, corner, pix) for each window of view i that covers voxel p
+  // and has a match, in scan order: its IRLS weight, its top-left exemplar
+  // pixel and the exemplar pixel it puts at p.
+  template <class Fn>
+  void for_each_covering(const int p[3], int i, Fn&& fn) const {
+    const View& w = views_[i];
+    const SliceAxes& s = kSlices[i];
+    const std::size_t width = std::size_t(w.ex->image().width());
+    const Covering cov = cover(p, s);
+    for (int a = 0; a < cov.nv; ++a) {
+      const std::size_t row_sp = (std::size_t(p[s.axis]) * w.nv + cov.sv[a]) * w.nu;
+      for (int b = 0; b < cov.nu; ++b) {
+        const std::size_t sp = row_sp + cov.su[b];
+        const int j = w.match[sp];
+        if (j < 0) continue;
+        const std::size_t corner = std::size_t(w.ex->centre_v(j) - lo_) * width + std::size_t(w.ex->centre_u(j) - lo_);
+        fn(w.weight[sp], corner, corner + std::size_t(cov.dv[a]) * width + std::size_t(cov.du[b]));
+      }
+    }
+  }
   // Voxel (x, y, z)'s values pulled towards the constraint's targets by its weight.
   void constrain(int x, int y, int z, float* values) const {
     if (constraint_.empty()) return;
