@@ -277,16 +277,23 @@ void LevelSolver::discrete_histogram(StageProgress& progress, std::vector<std::i
   ValueTables vt = value_tables();
   const double total = double(value_sample());
   std::vector<double> price(vt.target.size(), 0.0), kept = price;
-  double nearest = std::numeric_limits<double>::infinity();
+  std::vector<std::int64_t> kept_counts;
+  double nearest = std::numeric_limits<double>::infinity(), plain_distance = 0.0, step = opt_.histogram_values;
   int kept_round = 0, round = 0;
   for (; round < opt_.histogram_value_rounds && round - kept_round <= kValuePatience; ++round) {
     price_factors(price, vt);
-    const std::vector<std::int64_t> counts = chosen_histogram(vt, progress);
+    std::vector<std::int64_t> counts = chosen_histogram(vt, progress);
     const double d = histogram_distance(counts, vt.target, vt.channels, total);
-    if (d < nearest) nearest = d, kept = price, kept_round = round;
+    if (round == 0) plain_distance = d;
+    if (d < nearest) {
+      nearest = d, kept = price, kept_round = round, kept_counts = counts;
+    } else {  // farther: back to the nearest prices, half the step
+      price = kept, counts = kept_counts, step *= 0.5;
+    }
     for (std::size_t k = 0; k < price.size(); ++k)
-      price[k] += opt_.histogram_values * (double(counts[k]) / total - vt.target[k]);
+      price[k] += step * (double(counts[k]) / total - vt.target[k]);
   }
+  if (plain_distance < kValueMatched) kept_round = 0;
   // The units discrete_units() counted for rounds not run and, on the plain
   // path, for the second pass of write_values.
   const std::size_t rows = std::size_t(tex_.ny()) * tex_.nz();
