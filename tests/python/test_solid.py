@@ -364,10 +364,13 @@ def test_exemplar_values_are_the_exemplars_texels(what):
 
 
 def test_histogram_values_match_the_exemplars_histogram_with_its_texels():
-    # histogram_values (the histogram-matched exemplar-values pass): still
-    # only exemplar texels, and the solid's histogram (quality.hist_emd over
-    # all voxels, grey levels) closer to the exemplar's than the plain pass's.
-    ex = exemplar("granite1.png", size=48)
+    # histogram_values (the histogram-matched exemplar-values pass, the
+    # solids' default): still only exemplar texels, and the solid's histogram
+    # (quality.hist_emd over all voxels, grey levels) closer to the
+    # exemplar's than the plain pass's. On granite1 at 128^2 the default step
+    # overshoots; the prices then go back to the nearest round with half the
+    # step (without that: 5.35 -> 4.62, the bound's 0.7x not met).
+    ex = exemplar("granite1.png", size=128)
     palette = {tuple(p) for p in ex.reshape(-1, 3).tolist()}
     flat = lambda s: np.rint(s.reshape(-1, 3) * 255.0).astype(int)
     plain = optimizer_solid(ex, size=32, levels=2, seed=7, histogram_values=0)["solid"]
@@ -376,7 +379,7 @@ def test_histogram_values_match_the_exemplars_histogram_with_its_texels():
     assert all(tuple(t) in palette for t in flat(matched).tolist())
     before = quality.hist_emd(ex.astype(np.float64), flat(plain).astype(np.float64))
     after = quality.hist_emd(ex.astype(np.float64), flat(matched).astype(np.float64))
-    assert after < 0.8 * before, (before, after)  # measured 3.16 -> 2.18 (seed 7)
+    assert after < 0.7 * before, (before, after)  # measured 5.35 -> 2.87 (seed 7)
 
 
 def test_quality_metrics_on_known_cases():

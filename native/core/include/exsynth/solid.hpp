@@ -53,11 +53,12 @@ enum class SolidSearch {
 constexpr double kSolidFeatureWeight = 2.0;
 
 /// Solids' histogram_values (SolidOptions): the exemplar values match the
-/// exemplars' histogram. On 64^3 slices of 8 exemplars it changes only those
-/// whose plain values miss the histogram (stone33: contrast 0.76 -> 0.89,
-/// hist_emd 10.8 -> 7.3; brick, brownground), for 12-24 % more time at 128^3
-/// there; the others' nearest round is the plain pass, which then writes at
-/// its own cost (docs/solid.md, eleventh pass). Steps of 0.5 and more oscillate.
+/// exemplars' histogram. On 64^3 slices of 8 exemplars it changes those whose
+/// plain values miss the histogram (stone33: contrast 0.76 -> 0.89, hist_emd
+/// 10.8 -> 7.3; granite1, brick, slate, brownground), for 12-31 % more time
+/// at 128^3 there; where the plain values already match (crackedground,
+/// marble1) the plain pass writes at its own cost (docs/solid.md, eleventh
+/// pass). The first step; a round that overshoots halves it.
 constexpr double kSolidHistogramValues = 0.3;
 
 /// Bins per value channel of TextureOptimizationOptions::histogram_values
@@ -111,8 +112,9 @@ struct TextureOptimizationOptions {
   /// (kValueBins bins per value channel); histogram_value_rounds rounds of
   /// choices at fixed prices (counted on a sample of the voxels) raise the
   /// prices of over-full bins by this step times their excess share and
-  /// lower under-full ones, and the round nearest the histogram is written
-  /// (histogram_values.cpp); a changed choice that continues no neighbour's
+  /// lower under-full ones (a round that comes out farther goes back to the
+  /// nearest prices with half the step), and the round nearest the histogram
+  /// is written (histogram_values.cpp); a changed choice that continues no neighbour's
   /// keeps the plain texel (no speckle). 0 = off: the best-matching window's
   /// texel (images' default); solids default to kSolidHistogramValues.
   double histogram_values = 0.0;

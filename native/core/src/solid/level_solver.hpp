@@ -143,6 +143,9 @@ class LevelSolver {
   void discrete_histogram(StageProgress& progress, std::vector<std::int32_t>* source);
   void plain_values(StageProgress& progress, std::vector<std::int32_t>* source);  // discrete's plain pass
   static constexpr int kValuePatience = 8;  // rounds with no nearer histogram before the pricing stops
+  // The plain choices' histogram distance (1-D EMD in bins, summed over the
+  // value channels) below which they count as matched and are written as they are.
+  static constexpr double kValueMatched = 0.25;
   // TextureResult::source's code of a voxel's choice: view * 2^28 + exemplar
   // pixel; -1 = none (no window covers the voxel).
   static std::int32_t source_code(int view, std::size_t pix) {
