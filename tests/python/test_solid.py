@@ -324,8 +324,12 @@ def test_solid_keeps_a_floor_of_sharpness_and_contrast(name, sharp, contrast):
     # averaged -> exemplar values: crackedground 0.69 / 0.83 / 0.61 ->
     # 0.91 / 0.94 / 0.73, drkwood2 0.70 / 0.82 / 0.39 -> 0.96 / 0.85 / 0.47
     # (histogram_strength 3; at 1: 0.87 / 0.90 / 0.72 and 0.87 / 0.65 / 0.44);
-    # with the feature channel (feature_weight 2, the default) 0.98 / 0.97 / 0.75
-    # and 1.20 / 0.91 / 0.54. Solids stay
+    # with the feature channel (feature_weight 2) 0.98 / 0.97 / 0.75
+    # and 1.20 / 0.91 / 0.54; at 3 with histogram_values (the defaults)
+    # 1.02 / 0.99 / 0.78 and 1.29 / 0.86 / 0.58, against averaged 0.80 / 0.89
+    # / 0.66 and 0.58 / 0.57 / 0.39 (nn_rel rises with the weight: the
+    # feature channel pulls towards the exemplar's structure, not its nearest
+    # colour patches; docs/solid.md, what nn_rel measures). Solids stay
     # softer than images (docs/solid.md); the floor catches a blur regression
     # such as per-level trilinear smoothing, and exemplar values must add
     # sharpness over the averaged result without losing the structure.
@@ -337,7 +341,7 @@ def test_solid_keeps_a_floor_of_sharpness_and_contrast(name, sharp, contrast):
     a = optimizer_solid(ex, size=32, levels=2, seed=7, exemplar_values=False)["solid"]
     ma = quality.volume_metrics(E, a, slices=4)["mean"]
     assert m["sharpness"] >= ma["sharpness"] + 0.05, (m, ma)
-    assert m["nn_rel"] <= ma["nn_rel"] + 0.15, (m, ma)
+    assert m["nn_rel"] <= ma["nn_rel"] + 0.25, (m, ma)
 
 
 @pytest.mark.parametrize("what", ["solid", "image"])

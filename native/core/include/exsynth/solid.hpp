@@ -45,12 +45,14 @@ enum class SolidSearch {
 };
 
 /// Solids' feature_weight (SolidOptions): with it the slices of 64^3 solids
-/// of 8 exemplars come out crisper (sharpness 0.66 -> 0.88, contrast 0.79 ->
-/// 0.89, hist_emd 5.3 -> 4.6; 16 of 32 slice targets against 8) and the
-/// cow's cut faces show stones outlined by dark cracks where 0 gives soft
-/// blotches, for nn_rel 0.53 -> 0.62 and ~18 % more CPU; 4 overshoots the
-/// sharpness of some exemplars (docs/solid.md, ninth pass).
-constexpr double kSolidFeatureWeight = 2.0;
+/// of 8 exemplars come out crisper (weight 2: sharpness 0.66 -> 0.88,
+/// contrast 0.79 -> 0.89, hist_emd 5.3 -> 4.6; 16 of 32 slice targets against
+/// 8) and the cow's cut faces show stones outlined by dark cracks where 0
+/// gives soft blotches, for nn_rel 0.53 -> 0.62 and ~18 % more CPU (ninth
+/// pass). 3 with histogram_values (eleventh pass): stone33's stones get
+/// outlines, sharpness 0.92 -> 0.97 over the 8, 19 of 32 (drkwood2's contrast
+/// 0.81 at 3 without histogram_values; 4 overshoots; docs/solid.md).
+constexpr double kSolidFeatureWeight = 3.0;
 
 /// Solids' histogram_values (SolidOptions): the exemplar values match the
 /// exemplars' histogram. On 64^3 slices of 8 exemplars it changes those whose
