@@ -50,12 +50,13 @@ enum class SolidSearch {
 /// 8) and the cow's cut faces show stones outlined by dark cracks where 0
 /// gives soft blotches, for nn_rel 0.53 -> 0.62 and ~18 % more CPU (ninth
 /// pass). 3 with histogram_values (eleventh pass): stone33's stones get
-/// outlines, sharpness 0.92 -> 0.97 over the 8, 19 of 32 (drkwood2's contrast
-/// 0.81 at 3 without histogram_values; 4 overshoots; docs/solid.md).
+/// outlines, sharpness 0.92 -> 0.97 over the 8; slice targets 18 of 32 at
+/// 64^3 (as at 2) and 21 of 32 at 128^3 (19 at 2) (drkwood2's contrast 0.81
+/// at 3 without histogram_values; 4 overshoots; docs/solid.md).
 constexpr double kSolidFeatureWeight = 3.0;
 
 /// Solids' histogram_values (SolidOptions): the exemplar values match the
-/// exemplars' histogram. On 64^3 slices of 8 exemplars it changes those whose
+/// exemplars' histogram. On 64^3 slices of 8 exemplars (feature weight 2) it changes those whose
 /// plain values miss the histogram (stone33: contrast 0.76 -> 0.89, hist_emd
 /// 10.8 -> 7.3; granite1, brick, slate, brownground), for 12-31 % more time
 /// at 128^3 there; where the plain values already match (crackedground,
