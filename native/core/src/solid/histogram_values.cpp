@@ -259,10 +259,7 @@ void LevelSolver::write_values(const ValueTables& vt, StageProgress& progress, s
         if (code != plain[v] && coherent_choice(p, code, chosen)) plain[v] = code;
         const std::int32_t kept = plain[v];
         if (kept < 0) continue;  // no window covers p: keep the optimised value
-        float* out = tex_.data() + tex_.offset(x, y, z);
-        const float* e = views_[source_view(kept)].ex->image().data() + source_pixel(kept) * C_;
-        std::copy(e, e + C_, out);
-        constrain(x, y, z, out);
+        put_texel(x, y, z, source_view(kept), source_pixel(kept));
       }
     }
   });

@@ -591,10 +591,7 @@ void LevelSolver::plain_values(StageProgress& progress, std::vector<std::int32_t
           if (best_weight >= 0.0f && support > best_support) best_support = support, best_view = i, best_pix = pix;
         }
         if (best_view < 0) continue;  // no window covers p: keep the optimised value
-        float* out = tex_.data() + tex_.offset(x, y, z);
-        const float* e = views_[best_view].ex->image().data() + best_pix * C_;
-        std::copy(e, e + C_, out);
-        constrain(x, y, z, out);  // a requested target still wins by its weight
+        put_texel(x, y, z, best_view, best_pix);
         if (source) (*source)[tex_.voxel_index(x, y, z)] = source_code(best_view, best_pix);
       }
     }

@@ -173,6 +173,14 @@ class LevelSolver {
       }
     }
   }
+  // Voxel (x, y, z) takes exemplar pixel `pix` of view `view`'s exemplar (the
+  // exemplar values), then the constraint: a requested target still wins by its weight.
+  void put_texel(int x, int y, int z, int view, std::size_t pix) {
+    const float* e = views_[view].ex->image().data() + pix * C_;
+    float* out = tex_.data() + tex_.offset(x, y, z);
+    std::copy(e, e + C_, out);
+    constrain(x, y, z, out);
+  }
   // Voxel (x, y, z)'s values pulled towards the constraint's targets by its weight.
   void constrain(int x, int y, int z, float* values) const {
     if (constraint_.empty()) return;
