@@ -14,6 +14,7 @@ from PIL import Image
 from exsynth import _native
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 ex = np.asarray(Image.open(f"{ROOT}/assets/textures/crackedground.png").convert("RGB"))
+granite = np.asarray(Image.open(f"{ROOT}/assets/textures/granite1.png").convert("RGB"))  # priced histogram values
 ex6 = np.concatenate([ex, ex[::-1, ::-1]], axis=2).astype(np.float32) / 255.0
 cons = np.zeros((32, 32, 32, 4), np.float32); cons[..., :3] = 0.5; cons[8:16, 8:16, 8:16, 3] = 0.7
 cases = [
@@ -29,12 +30,15 @@ cases = [
     ("solid32_feature", lambda: _native.synthesize_solid(ex, size=32, seed=10, feature_weight=1.0)),
     ("solid48_plainvalues", lambda: _native.synthesize_solid(ex, size=48, seed=11, histogram_values=0)),
     ("solid48_histvalues", lambda: _native.synthesize_solid(ex, size=48, seed=12, histogram_values=0.1, histogram_value_window=0.5)),
+    ("solid48_granite_priced", lambda: _native.synthesize_solid(granite, size=48, seed=13)),
+    ("solid40_granite_window", lambda: _native.synthesize_solid(granite, size=40, seed=14, histogram_value_window=0.5)),
     ("image128_opt", lambda: _native.synthesize_image(ex, width=128, height=128, seed=1, method="optimization")),
     ("image96_opt_tile", lambda: _native.synthesize_image(ex, width=96, height=80, seed=2, method="optimization", tileable=True)),
     ("coord64", lambda: _native.synthesize_solid(ex, size=64, seed=1, method="coordinates")),
 ]
 if len(sys.argv) > 1 and sys.argv[1] == "full":
     cases.append(("solid128", lambda: _native.synthesize_solid(ex, size=128, seed=1)))
+    cases.append(("solid128_granite", lambda: _native.synthesize_solid(granite, size=128, seed=1)))
 only = os.environ.get("ONLY")
 threads = int(sys.argv[2]) if len(sys.argv) > 2 else 0
 for name, fn in cases:

@@ -124,37 +124,62 @@ void LevelSolver::price_factors(const std::vector<double>& price, ValueTables& v
   }
 }
 
-// Voxel p's choice at the current prices (see the file comment). Supports
-// are summed in float in the plain pass's order and scores compared in
-// double, strictly (ties: the first in view, then scan order), so with unit
-// factors the choice is exactly the plain pass's: within the best view only
-// its first best window scores S_max, every other proposal scores below.
-LevelSolver::Choice LevelSolver::choose_value(const int p[3], const ValueTables& vt, std::vector<Proposal>& proposals,
-                                              Choice* plain) const {
-  proposals.clear();
+// Voxel p's proposals (see the file comment), appended to `out` in the
+// plain pass's order (view, then scan order): each covering window's texel
+// with S_i * w_t / W_i, its score before prices. Supports are summed in float
+// in the plain pass's order and the score is formed in double, so with unit
+// price factors the strict maximum is exactly the plain pass's texel: within
+// the best view only its first best window scores S_max, every other
+// proposal scores below.
+void LevelSolver::value_proposals(const int p[3], std::vector<Proposal>& out) const {
+  const std::size_t first = out.size();
   float support[3] = {0.0f, 0.0f, 0.0f}, best[3] = {0.0f, 0.0f, 0.0f};
   for (int i = 0; i < 3; ++i) {
     if (!views_[i].ex) continue;
     for_each_covering(p, i, [&](float wt, std::size_t corner, std::size_t pix) {
       support[i] += wt;
       best[i] = std::max(best[i], wt);
-      proposals.push_back({i, corner, pix, wt});
+      out.push_back({double(wt), source_code(i, pix), std::uint32_t(corner)});  // the weight until the supports are known
     });
   }
-  Choice choice;
-  double best_score = -1.0, best_plain = -1.0;
-  for (const Proposal& q : proposals) {
-    const double rel = best[q.view] > 0.0f ? double(q.weight) / double(best[q.view]) : 1.0;
-    const std::size_t e = std::size_t(vt.of[q.view]);
-    const double unpriced = double(support[q.view]) * rel;
-    const double score = unpriced / (double(vt.factor[e][q.pix]) * double(vt.window[e][q.corner]));
-    if (score > best_score) best_score = score, choice = {q.view, q.pix};
-    if (plain && unpriced > best_plain) best_plain = unpriced, *plain = {q.view, q.pix};
+  for (std::size_t k = first; k < out.size(); ++k) {
+    const int view = source_view(out[k].code);
+    const double rel = best[view] > 0.0f ? out[k].unpriced / double(best[view]) : 1.0;
+    out[k].unpriced = double(support[view]) * rel;
   }
-  return choice;
 }
 
-// The voxels whose choices the pricing rounds count: all of them up to
+// The code of the best-scoring proposal in [begin, end) at the current prices
+// (ties: the first), -1 for none.
+std::int32_t LevelSolver::priced_choice(const Proposal* begin, const Proposal* end, const ValueTables& vt) const {
+  double best_score = -1.0;
+  std::int32_t code = -1;
+  for (const Proposal* q = begin; q != end; ++q) {
+    const std::size_t e = std::size_t(vt.of[source_view(q->code)]), pix = source_pixel(q->code);
+    const double score = q->unpriced / (double(vt.factor[e][pix]) * double(vt.window[e][q->corner]));
+    if (score > best_score) best_score = score, code = q->code;
+  }
+  return code;
+}
+
+// Voxel p's choice at the current prices; `plain`, when given, receives the
+// unpriced best (the plain pass's texel).
+LevelSolver::Choice LevelSolver::choose_value(const int p[3], const ValueTables& vt, std::vector<Proposal>& proposals,
+                                              Choice* plain) const {
+  proposals.clear();
+  value_proposals(p, proposals);
+  auto choice_of = [](std::int32_t code) { return code < 0 ? Choice{} : Choice{source_view(code), source_pixel(code)}; };
+  if (plain) {
+    double best_plain = -1.0;
+    std::int32_t code = -1;
+    for (const Proposal& q : proposals)
+      if (q.unpriced > best_plain) best_plain = q.unpriced, code = q.code;
+    *plain = choice_of(code);
+  }
+  return choice_of(priced_choice(proposals.data(), proposals.data() + proposals.size(), vt));
+}
+
+// The voxels the pricing rounds count: all of them up to
 // kValueSample (32768), else kValueSample spread over the solid (i * P mod N, P a
 // prime above any edge, so coprime with N: distinct voxels, no lattice
 // aligned with the sparse grid's parity). A histogram of 32768 voxels is
@@ -162,33 +187,65 @@ LevelSolver::Choice LevelSolver::choose_value(const int p[3], const ValueTables&
 // of a pass each at 64^3 and above (16 full rounds took 5 s of CPU at 64^3).
 std::size_t LevelSolver::value_sample() const { return std::min<std::size_t>(tex_.voxel_count(), kValueSample); }
 
-// The histogram (channels x kValueBins counts) of the sample's choices at
-// the current prices, nothing written: a chosen texel counts by its own bins
-// (the constraint, applied when writing, pulls values the prices cannot
-// move), a voxel no window covers by the value it keeps. Integer counts: the
-// sum does not depend on the order chunks finish in.
-std::vector<std::int64_t> LevelSolver::chosen_histogram(const ValueTables& vt, StageProgress& progress) const {
+// The sample's proposals, gathered once for all rounds (16 bytes each, up to
+// 3 (n/2)^2 per voxel: 25 MB at n = 8). Gathering them every round took
+// about as long as the plain pass over a 128^3 solid for 32 rounds (stone33:
+// 2.2 s CPU for rounds 2..32, docs/solid.md). A voxel no window covers counts
+// by the value it keeps (the constraint, applied when writing, pulls values
+// the prices cannot move). Integer counts: the sum does not depend on the
+// order chunks finish in.
+LevelSolver::SampleProposals LevelSolver::sample_proposals(const ValueTables& vt, StageProgress& progress) const {
   const std::size_t N = tex_.voxel_count(), M = value_sample(), nx = std::size_t(tex_.nx()), ny = std::size_t(tex_.ny());
   constexpr std::uint64_t kSpread = 2654435761u;  // prime, above kMaxSolidSize
   const int V = vt.channels;
-  std::vector<std::int64_t> counts(vt.target.size(), 0);
-  std::mutex merge;
   const std::size_t chunks = (M + kValueChunk - 1) / kValueChunk;
+  SampleProposals sample;
+  sample.proposals.resize(chunks);
+  sample.ends.resize(chunks);
+  sample.uncovered.assign(vt.target.size(), 0);
+  std::mutex merge;
   parallel_chunks(chunks, 1, progress, [&](std::size_t c0, std::size_t c1) {
-    std::vector<std::int64_t> local(counts.size(), 0);
-    std::vector<Proposal> proposals;
-    for (std::size_t i = c0 * kValueChunk; i < std::min(M, c1 * kValueChunk); ++i) {
-      const std::size_t v = M == N ? i : std::size_t((std::uint64_t(i) * kSpread) % N);
-      const int p[3] = {int(v % nx), int((v / nx) % ny), int(v / (nx * ny))};
-      const Choice ch = choose_value(p, vt, proposals);
-      if (ch.view >= 0) {
-        const std::uint8_t* bins = vt.bins[std::size_t(vt.of[ch.view])].data() + ch.pix * V;
-        for (int c = 0; c < V; ++c) ++local[std::size_t(c) * kValueBins + bins[c]];
-        continue;
+    std::vector<std::int64_t> local(sample.uncovered.size(), 0);
+    for (std::size_t c = c0; c < c1; ++c) {
+      std::vector<Proposal>& proposals = sample.proposals[c];
+      std::vector<std::uint32_t>& ends = sample.ends[c];
+      for (std::size_t i = c * kValueChunk; i < std::min(M, (c + 1) * kValueChunk); ++i) {
+        const std::size_t v = M == N ? i : std::size_t((std::uint64_t(i) * kSpread) % N);
+        const int p[3] = {int(v % nx), int((v / nx) % ny), int(v / (nx * ny))};
+        const std::size_t before = proposals.size();
+        value_proposals(p, proposals);
+        ends.push_back(std::uint32_t(proposals.size()));
+        if (proposals.size() > before) continue;
+        const float* kept = tex_.data() + v * std::size_t(C_);
+        for (int ch = 0; ch < V; ++ch)
+          ++local[std::size_t(ch) * kValueBins + value_bin(kept[ch], channel_lo_[ch], channel_hi_[ch], kValueBins)];
       }
-      const float* kept = tex_.data() + v * std::size_t(C_);
-      for (int c = 0; c < V; ++c)
-        ++local[std::size_t(c) * kValueBins + value_bin(kept[c], channel_lo_[c], channel_hi_[c], kValueBins)];
+    }
+    std::lock_guard<std::mutex> lock(merge);
+    for (std::size_t k = 0; k < local.size(); ++k) sample.uncovered[k] += local[k];
+  });
+  return sample;
+}
+
+// The histogram (channels x kValueBins counts) of the sample's choices at
+// the current prices, nothing written; the uncovered voxels' counts as gathered.
+std::vector<std::int64_t> LevelSolver::chosen_histogram(const ValueTables& vt, const SampleProposals& sample,
+                                                        StageProgress& progress) const {
+  const int V = vt.channels;
+  std::vector<std::int64_t> counts = sample.uncovered;
+  std::mutex merge;
+  parallel_chunks(sample.proposals.size(), 1, progress, [&](std::size_t c0, std::size_t c1) {
+    std::vector<std::int64_t> local(counts.size(), 0);
+    for (std::size_t c = c0; c < c1; ++c) {
+      const Proposal* proposals = sample.proposals[c].data();
+      std::uint32_t begin = 0;
+      for (const std::uint32_t end : sample.ends[c]) {
+        const std::int32_t code = priced_choice(proposals + begin, proposals + end, vt);
+        begin = end;
+        if (code < 0) continue;  // uncovered: counted once in sample.uncovered
+        const std::uint8_t* bins = vt.bins[std::size_t(vt.of[source_view(code)])].data() + source_pixel(code) * V;
+        for (int ch = 0; ch < V; ++ch) ++local[std::size_t(ch) * kValueBins + bins[ch]];
+      }
     }
     std::lock_guard<std::mutex> lock(merge);
     for (std::size_t k = 0; k < counts.size(); ++k) counts[k] += local[k];
@@ -276,6 +333,7 @@ void LevelSolver::write_values(const ValueTables& vt, StageProgress& progress, s
 // with histogram_values = 0.
 void LevelSolver::discrete_histogram(StageProgress& progress, std::vector<std::int32_t>* source) {
   ValueTables vt = value_tables();
+  const SampleProposals sample = sample_proposals(vt, progress);
   const double total = double(value_sample());
   std::vector<double> price(vt.target.size(), 0.0), kept = price;
   std::vector<std::int64_t> kept_counts;
@@ -283,7 +341,7 @@ void LevelSolver::discrete_histogram(StageProgress& progress, std::vector<std::i
   int kept_round = 0, round = 0;
   for (; round < opt_.histogram_value_rounds && round - kept_round <= kValuePatience; ++round) {
     price_factors(price, vt);
-    std::vector<std::int64_t> counts = chosen_histogram(vt, progress);
+    std::vector<std::int64_t> counts = chosen_histogram(vt, sample, progress);
     const double d = histogram_distance(counts, vt.target, vt.channels, total);
     if (round == 0 && d < kValueMatched) {  // already matched: the plain pass writes
       round = 1;

@@ -3,6 +3,7 @@
 // grid for each active view, and the two phases that alternate on them.
 #include <algorithm>
 #include <array>
+#include <cmath>
 #include <cstdint>
 #include <memory>
 #include <vector>
@@ -54,13 +55,21 @@ class LevelSolver {
   /// (discrete_histogram).
   void discrete(StageProgress& progress, std::vector<std::int32_t>* source = nullptr);
 
+  /// Bytes of the histogram_values pricing rounds' proposals (SampleProposals)
+  /// for a solid of `voxels` with n x n windows: at most 3 ceil(n/2)^2 per sampled voxel.
+  static double sample_proposal_bytes(double voxels, int n) {
+    const double per_view = std::ceil(n / 2.0) * std::ceil(n / 2.0);
+    return std::min(voxels, double(kValueSample)) * (3.0 * per_view * sizeof(Proposal) + sizeof(std::uint32_t));
+  }
+
   /// Units of progress each phase reports (for StageProgress totals).
   std::size_t search_units() const;
   std::size_t optimize_units() const;
   std::size_t discrete_units() const {
     const std::size_t rows = std::size_t(tex_.ny()) * tex_.nz();
     if (opt_.histogram_values <= 0) return rows;
-    return 2 * rows + std::size_t(opt_.histogram_value_rounds) * ((value_sample() + kValueChunk - 1) / kValueChunk);
+    // the sample's proposals (once), the rounds, then write_values' two passes
+    return 2 * rows + std::size_t(opt_.histogram_value_rounds + 1) * ((value_sample() + kValueChunk - 1) / kValueChunk);
   }
 
  private:
@@ -118,16 +127,28 @@ class LevelSolver {
     std::array<int, 3> of{-1, -1, -1};               // per view: its exemplar's tables
     std::vector<double> target;                      // channels * kValueBins fractions
   };
-  // One covering window's proposal for a voxel: the view and the exemplar
-  // pixel it puts there, and the window's IRLS weight.
+  // One covering window's proposal for a voxel: the texel it puts there
+  // (source_code(view, pixel)), the window's top-left exemplar pixel and its
+  // score before prices (the view's summed weight over the voxel times the
+  // window's weight relative to the view's best; see choose_value).
   struct Proposal {
-    int view;
-    std::size_t corner, pix;  // the window's top-left exemplar pixel, the texel's
-    float weight;
+    double unpriced;
+    std::int32_t code;
+    std::uint32_t corner;
   };
   struct Choice {
     int view = -1;  // -1: no window covers the voxel
     std::size_t pix = 0;
+  };
+  // The pricing rounds' voxels and their proposals, gathered once: the
+  // proposals do not change between rounds, only the prices do. Per chunk of
+  // kValueChunk sample voxels, the proposals in voxel order and each voxel's
+  // end among them (an empty range: no window covers it); plus the counts of
+  // the values the uncovered voxels keep.
+  struct SampleProposals {
+    std::vector<std::vector<Proposal>> proposals;
+    std::vector<std::vector<std::uint32_t>> ends;
+    std::vector<std::int64_t> uncovered;
   };
   static constexpr std::size_t kValueSample = std::size_t(1) << 15;  // voxels the pricing rounds count
   static constexpr std::size_t kValueChunk = 1024;                   // of them per parallel chunk
@@ -135,10 +156,14 @@ class LevelSolver {
   ValueTables value_tables() const;
   void price_factors(const std::vector<double>& price, ValueTables& vt) const;
   // The priced choice; `plain`, when given, receives the unpriced one (the plain pass's).
+  void value_proposals(const int p[3], std::vector<Proposal>& out) const;  // appends voxel p's, in scan order
+  std::int32_t priced_choice(const Proposal* begin, const Proposal* end, const ValueTables& vt) const;
   Choice choose_value(const int p[3], const ValueTables& vt, std::vector<Proposal>& proposals,
                       Choice* plain = nullptr) const;
+  SampleProposals sample_proposals(const ValueTables& vt, StageProgress& progress) const;
   bool coherent_choice(const int p[3], std::int32_t code, const std::vector<std::int32_t>& chosen) const;
-  std::vector<std::int64_t> chosen_histogram(const ValueTables& vt, StageProgress& progress) const;
+  std::vector<std::int64_t> chosen_histogram(const ValueTables& vt, const SampleProposals& sample,
+                                             StageProgress& progress) const;
   void write_values(const ValueTables& vt, StageProgress& progress, std::vector<std::int32_t>* source);
   void discrete_histogram(StageProgress& progress, std::vector<std::int32_t>* source);
   void plain_values(StageProgress& progress, std::vector<std::int32_t>* source);  // discrete's plain pass

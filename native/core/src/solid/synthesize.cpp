@@ -230,7 +230,8 @@ void check_texture_memory(const Job& job, const TextureOptimizationOptions& opt,
   // (+ 8 bytes per sparse voxel and view: the optimisation's window table, level_solver.hpp)
   double texture_bytes = voxels * channels * 4.0 * 2.0 + voxels * 3.0 / 4.0 * (16.0 + 8.0);
   if (opt.exemplar_values) texture_bytes += voxels * 4.0;  // TextureResult::source
-  if (opt.exemplar_values && opt.histogram_values > 0) texture_bytes += voxels * 4.0;  // the plain choices (write_values)
+  if (opt.exemplar_values && opt.histogram_values > 0)  // the plain choices (write_values), the rounds' proposals
+    texture_bytes += voxels * 4.0 + solid::LevelSolver::sample_proposal_bytes(voxels, n);
   if (p.constraint && !p.constraint->empty()) texture_bytes += voxels * (p.user_channels + 1) * 4.0 * 8.0 / 7.0;
   double exemplar_bytes = 0;
   const Image* largest = p.images[0];
