@@ -33,6 +33,8 @@
 #include <limits>
 #include <mutex>
 
+#include <tbb/enumerable_thread_specific.h>
+
 #include "exsynth/parallel.hpp"
 #include "solid/level_solver.hpp"
 
@@ -124,29 +126,34 @@ void LevelSolver::price_factors(const std::vector<double>& price, ValueTables& v
   }
 }
 
-// Voxel p's proposals (see the file comment), appended to `out` in the
-// plain pass's order (view, then scan order): each covering window's texel
-// with S_i * w_t / W_i, its score before prices. Supports are summed in float
-// in the plain pass's order and the score is formed in double, so with unit
-// price factors the strict maximum is exactly the plain pass's texel: within
-// the best view only its first best window scores S_max, every other
-// proposal scores below.
-void LevelSolver::value_proposals(const int p[3], std::vector<Proposal>& out) const {
-  const std::size_t first = out.size();
+// Voxel p's proposals (see the file comment), written to out[0..count) in
+// the plain pass's order (view, then scan order): each covering window's
+// texel with S_i * w_t / W_i, its score before prices. Supports are summed in
+// float in the plain pass's order and the score is formed in double, so with
+// unit price factors the strict maximum is exactly the plain pass's texel:
+// within the best view only its first best window scores S_max, every other
+// proposal scores below. `out` holds max_proposals() (a raw buffer, not
+// push_back: the vector's end pointer was stored at every proposal, 40 % of
+// this function's samples in perf).
+std::size_t LevelSolver::value_proposals(const int p[3], Proposal* out) const {
+  std::size_t count = 0, first[4] = {0, 0, 0, 0};
   float support[3] = {0.0f, 0.0f, 0.0f}, best[3] = {0.0f, 0.0f, 0.0f};
   for (int i = 0; i < 3; ++i) {
+    first[i] = count;
     if (!views_[i].ex) continue;
     for_each_covering(p, i, [&](float wt, std::size_t corner, std::size_t pix) {
       support[i] += wt;
       best[i] = std::max(best[i], wt);
-      out.push_back({double(wt), source_code(i, pix), std::uint32_t(corner)});  // the weight until the supports are known
+      out[count++] = {double(wt), source_code(i, pix), std::uint32_t(corner)};  // the weight until the supports are known
     });
   }
-  for (std::size_t k = first; k < out.size(); ++k) {
-    const int view = source_view(out[k].code);
-    const double rel = best[view] > 0.0f ? out[k].unpriced / double(best[view]) : 1.0;
-    out[k].unpriced = double(support[view]) * rel;
-  }
+  first[3] = count;
+  for (int i = 0; i < 3; ++i)
+    for (std::size_t k = first[i]; k < first[i + 1]; ++k) {
+      const double rel = best[i] > 0.0f ? out[k].unpriced / double(best[i]) : 1.0;
+      out[k].unpriced = double(support[i]) * rel;
+    }
+  return count;
 }
 
 // The code of the best-scoring proposal in [begin, end) at the current prices
@@ -166,17 +173,18 @@ std::int32_t LevelSolver::priced_choice(const Proposal* begin, const Proposal* e
 // unpriced best (the plain pass's texel).
 LevelSolver::Choice LevelSolver::choose_value(const int p[3], const ValueTables& vt, std::vector<Proposal>& proposals,
                                               Choice* plain) const {
-  proposals.clear();
-  value_proposals(p, proposals);
+  if (proposals.size() < max_proposals()) proposals.resize(max_proposals());
+  const Proposal* begin = proposals.data();
+  const Proposal* end = begin + value_proposals(p, proposals.data());
   auto choice_of = [](std::int32_t code) { return code < 0 ? Choice{} : Choice{source_view(code), source_pixel(code)}; };
   if (plain) {
     double best_plain = -1.0;
     std::int32_t code = -1;
-    for (const Proposal& q : proposals)
-      if (q.unpriced > best_plain) best_plain = q.unpriced, code = q.code;
+    for (const Proposal* q = begin; q != end; ++q)
+      if (q->unpriced > best_plain) best_plain = q->unpriced, code = q->code;
     *plain = choice_of(code);
   }
-  return choice_of(priced_choice(proposals.data(), proposals.data() + proposals.size(), vt));
+  return choice_of(priced_choice(begin, end, vt));
 }
 
 // The voxels the pricing rounds count: all of them up to
@@ -213,7 +221,8 @@ LevelSolver::SampleProposals LevelSolver::sample_proposals(const ValueTables& vt
         const std::size_t v = M == N ? i : std::size_t((std::uint64_t(i) * kSpread) % N);
         const int p[3] = {int(v % nx), int((v / nx) % ny), int(v / (nx * ny))};
         const std::size_t before = proposals.size();
-        value_proposals(p, proposals);
+        proposals.resize(before + max_proposals());
+        proposals.resize(before + value_proposals(p, proposals.data() + before));
         ends.push_back(std::uint32_t(proposals.size()));
         if (proposals.size() > before) continue;
         const float* kept = tex_.data() + v * std::size_t(C_);
@@ -290,19 +299,14 @@ void LevelSolver::write_values(const ValueTables& vt, StageProgress& progress, s
   std::vector<std::int32_t>& chosen = source ? *source : own;
   chosen.assign(tex_.voxel_count(), -1);
   std::vector<std::int32_t> plain(tex_.voxel_count(), -1);
-  parallel_chunks(rows, 1, progress, [&](std::size_t r0, std::size_t r1) {
-    std::vector<Proposal> proposals;
-    for (std::size_t row = r0; row < r1; ++row) {
-      const int y = int(row % std::size_t(dims[1])), z = int(row / std::size_t(dims[1]));
-      for (int x = 0; x < dims[0]; ++x) {
-        const int p[3] = {x, y, z};
-        Choice unpriced;
-        const Choice ch = choose_value(p, vt, proposals, &unpriced);
-        const std::size_t v = tex_.voxel_index(x, y, z);
-        chosen[v] = source_code(ch.view, ch.pix);
-        plain[v] = source_code(unpriced.view, unpriced.pix);
-      }
-    }
+  tbb::enumerable_thread_specific<std::vector<Proposal>> scratch;
+  for_each_voxel_tiled(progress, [&](int x, int y, int z) {
+    const int p[3] = {x, y, z};
+    Choice unpriced;
+    const Choice ch = choose_value(p, vt, scratch.local(), &unpriced);
+    const std::size_t v = tex_.voxel_index(x, y, z);
+    chosen[v] = source_code(ch.view, ch.pix);
+    plain[v] = source_code(unpriced.view, unpriced.pix);
   });
   // plain[v] becomes v's final choice: each voxel reads only its own entry of
   // plain, and its neighbours' of chosen.

@@ -42,6 +42,7 @@ LevelSolver::LevelSolver(Volume& texture, std::array<const ExemplarIndex*, 3> vi
         ac.d[k] = d;
         ac.s[k] = c / 2;
       }
+    max_cover_ = std::max(max_cover_, *std::max_element(ac.count.begin(), ac.count.end()));
   }
   for (int i = 0; i < 3; ++i) {
     View& w = views_[i];
@@ -567,34 +568,27 @@ void LevelSolver::discrete(StageProgress& progress, std::vector<std::int32_t>* s
 }
 
 void LevelSolver::plain_values(StageProgress& progress, std::vector<std::int32_t>* source) {
-  const int dims[3] = {tex_.nx(), tex_.ny(), tex_.nz()};
   if (source) source->assign(tex_.voxel_count(), -1);
-  // Rows of voxels (y, z) in parallel: an image is a single z-slice.
-  parallel_chunks(std::size_t(dims[1]) * dims[2], 1, progress, [&](std::size_t r0, std::size_t r1) {
-    for (std::size_t row = r0; row < r1; ++row) {
-      const int y = int(row % std::size_t(dims[1])), z = int(row / std::size_t(dims[1]));
-      for (int x = 0; x < dims[0]; ++x) {
-        const int p[3] = {x, y, z};
-        int best_view = -1;
-        std::size_t best_pix = 0;
-        float best_support = -1.0f;
-        for (int i = 0; i < 3; ++i) {
-          if (!views_[i].ex) continue;
-          float best_weight = -1.0f, support = 0.0f;
-          std::size_t pix = 0;
-          for_each_covering(p, i, [&](float wt, std::size_t, std::size_t texel) {
-            support += wt;
-            if (wt <= best_weight) return;  // ties: the first in scan order
-            best_weight = wt;
-            pix = texel;
-          });
-          if (best_weight >= 0.0f && support > best_support) best_support = support, best_view = i, best_pix = pix;
-        }
-        if (best_view < 0) continue;  // no window covers p: keep the optimised value
-        put_texel(x, y, z, best_view, best_pix);
-        if (source) (*source)[tex_.voxel_index(x, y, z)] = source_code(best_view, best_pix);
-      }
+  for_each_voxel_tiled(progress, [&](int x, int y, int z) {
+    const int p[3] = {x, y, z};
+    int best_view = -1;
+    std::size_t best_pix = 0;
+    float best_support = -1.0f;
+    for (int i = 0; i < 3; ++i) {
+      if (!views_[i].ex) continue;
+      float best_weight = -1.0f, support = 0.0f;
+      std::size_t pix = 0;
+      for_each_covering(p, i, [&](float wt, std::size_t, std::size_t texel) {
+        support += wt;
+        if (wt <= best_weight) return;  // ties: the first in scan order
+        best_weight = wt;
+        pix = texel;
+      });
+      if (best_weight >= 0.0f && support > best_support) best_support = support, best_view = i, best_pix = pix;
     }
+    if (best_view < 0) return;  // no window covers p: keep the optimised value
+    put_texel(x, y, z, best_view, best_pix);
+    if (source) (*source)[tex_.voxel_index(x, y, z)] = source_code(best_view, best_pix);
   });
 }
 

@@ -10,6 +10,7 @@
 
 #include "exsynth/exec_context.hpp"
 #include "exsynth/grid.hpp"
+#include "exsynth/parallel.hpp"
 #include "exsynth/solid.hpp"
 #include "search/kd_tree.hpp"
 #include "solid/candidate_scoring.hpp"
@@ -156,7 +157,9 @@ class LevelSolver {
   ValueTables value_tables() const;
   void price_factors(const std::vector<double>& price, ValueTables& vt) const;
   // The priced choice; `plain`, when given, receives the unpriced one (the plain pass's).
-  void value_proposals(const int p[3], std::vector<Proposal>& out) const;  // appends voxel p's, in scan order
+  std::size_t value_proposals(const int p[3], Proposal* out) const;  // voxel p's, in scan order; their count
+  // Room value_proposals needs: the most covering windows of a voxel in each view.
+  std::size_t max_proposals() const { return 3 * std::size_t(max_cover_) * std::size_t(max_cover_); }
   std::int32_t priced_choice(const Proposal* begin, const Proposal* end, const ValueTables& vt) const;
   Choice choose_value(const int p[3], const ValueTables& vt, std::vector<Proposal>& proposals,
                       Choice* plain = nullptr) const;
@@ -197,6 +200,21 @@ class LevelSolver {
         fn(w.weight[sp], corner, corner + std::size_t(cov.dv[a]) * width + std::size_t(cov.du[b]));
       }
     }
+  }
+  // fn(x, y, z) for every voxel, in parallel over groups of up to kTileRows
+  // rows (y, z), each walked in tiles of kTileX columns: a tile's voxels share
+  // the sparse windows of every view (the x-view's slices change along x), so
+  // the exemplar-values passes read them from cache. Row by row the x-view
+  // took a new slice's windows at every voxel. Progress: one unit per row.
+  static constexpr int kTileRows = 8, kTileX = 8;
+  template <class Fn>
+  void for_each_voxel_tiled(StageProgress& progress, Fn&& fn) const {
+    const int nx = tex_.nx(), ny = tex_.ny();
+    parallel_chunks(std::size_t(ny) * tex_.nz(), kTileRows, progress, [&](std::size_t r0, std::size_t r1) {
+      for (int x0 = 0; x0 < nx; x0 += kTileX)
+        for (std::size_t row = r0; row < r1; ++row)
+          for (int x = x0; x < std::min(x0 + kTileX, nx); ++x) fn(x, int(row % std::size_t(ny)), int(row / std::size_t(ny)));
+    });
   }
   // Voxel (x, y, z) takes exemplar pixel `pix` of view `view`'s exemplar (the
   // exemplar values), then the constraint: a requested target still wins by its weight.
@@ -244,6 +262,7 @@ class LevelSolver {
   std::vector<float> channel_lo_, channel_hi_;
   std::array<std::vector<int>, 3> wrapped_;  // per axis: coordinate x + n -> wrapped/clamped x
   std::array<AxisCover, 3> axis_cover_;
+  int max_cover_ = 0;  // the largest count of axis_cover_ (about n/2; one more where an odd edge wraps)
 
   // The PCA coefficients for the k-coherence scoring, one 64-byte aligned
   // row per window with a stride of whole cache lines (16 floats): the first
