@@ -8,7 +8,7 @@ so speed and quality are read together. The coordinates rows' energy is
 another unit (the last correction pass's mean crossbar cost in appearance
 space); "cpu s" is the whole process's user+sys.
 
-usage: bench_solid.py --build BUILD_DIR [--cases solid128,solid256,image256,coord64,coord128]
+usage: bench_solid.py --build BUILD_DIR [--cases solid128,solid128_brick,solid256,image256,coord64,coord128]
 """
 import argparse
 import json
@@ -22,17 +22,23 @@ EXEMPLAR = os.path.join(ROOT, "assets", "textures", "crackedground.png")  # 128 
 CASES = {
     # name: (description, python statement producing `res` from `ex`)
     "solid128": ("solid 128^3 RGB, 3 levels", "res = _native.synthesize_solid(ex, size=128, levels=3, seed=1)"),
+    # brick (gimp-data, 128^2 as in bench_quality.py): its plain values miss the histogram, so the
+    # histogram-priced exemplar values run (crackedground's already match and take the plain pass)
+    "solid128_brick": ("solid 128^3 RGB, brick (priced)",
+                       "sys.path.insert(0, BENCH); from bench_quality import exemplar; ex = exemplar('brick'); "
+                       "res = _native.synthesize_solid(ex, size=128, levels=3, seed=1)"),
     "solid256": ("solid 256^3 RGB, 3 levels", "res = _native.synthesize_solid(ex, size=256, levels=3, seed=1)"),
     "image256": ("image 128^2 -> 256^2, 3 levels", "res = _native.synthesize_image(ex, width=256, height=256, seed=1)"),
     # method="coordinates" (exemplar coordinates; the solid rows above use the default method)
     "coord64": ("solid 64^3 RGB, coordinates", "res = _native.synthesize_solid(ex, size=64, seed=1, method='coordinates')"),
     "coord128": ("solid 128^3 RGB, coordinates", "res = _native.synthesize_solid(ex, size=128, seed=1, method='coordinates')"),
 }
-DEFAULT_CASES = "solid128,solid256,image256"
+DEFAULT_CASES = "solid128,solid128_brick,solid256,image256"
 
 
 CHILD = """
 import json, sys, time
+BENCH = {bench!r}
 import numpy as np
 from PIL import Image
 from exsynth import _native
@@ -48,7 +54,7 @@ print(json.dumps({{"seconds": dt, "energy": res["energy"][-1], "cpu": r.ru_utime
 
 def run_case(build, stmt):
     env = dict(os.environ, PYTHONPATH=os.path.join(build, "addon"))
-    proc = subprocess.Popen(["/usr/bin/python3", "-c", CHILD.format(stmt=stmt), EXEMPLAR],
+    proc = subprocess.Popen(["/usr/bin/python3", "-c", CHILD.format(stmt=stmt, bench=os.path.dirname(os.path.abspath(__file__))), EXEMPLAR],
                             stdout=subprocess.PIPE, env=env, text=True)
     out = proc.stdout.read()
     _, status, usage = os.wait4(proc.pid, 0)
