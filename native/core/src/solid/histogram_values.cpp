@@ -157,13 +157,25 @@ std::size_t LevelSolver::value_proposals(const int p[3], Proposal* out) const {
 }
 
 // The code of the best-scoring proposal in [begin, end) at the current prices
-// (ties: the first), -1 for none.
+// (ties: the first), -1 for none. Without the window share (beta = 0, the
+// default) every window factor is exactly 1 and is not read: the same scores.
 std::int32_t LevelSolver::priced_choice(const Proposal* begin, const Proposal* end, const ValueTables& vt) const {
+  const float* factor[3] = {nullptr, nullptr, nullptr};
+  const float* window[3] = {nullptr, nullptr, nullptr};
+  for (int i = 0; i < 3; ++i)
+    if (vt.of[i] >= 0) factor[i] = vt.factor[std::size_t(vt.of[i])].data(), window[i] = vt.window[std::size_t(vt.of[i])].data();
   double best_score = -1.0;
   std::int32_t code = -1;
+  if (opt_.histogram_value_window == 0.0) {
+    for (const Proposal* q = begin; q != end; ++q) {
+      const double score = q->unpriced / double(factor[source_view(q->code)][source_pixel(q->code)]);
+      if (score > best_score) best_score = score, code = q->code;
+    }
+    return code;
+  }
   for (const Proposal* q = begin; q != end; ++q) {
-    const std::size_t e = std::size_t(vt.of[source_view(q->code)]), pix = source_pixel(q->code);
-    const double score = q->unpriced / (double(vt.factor[e][pix]) * double(vt.window[e][q->corner]));
+    const int view = source_view(q->code);
+    const double score = q->unpriced / (double(factor[view][source_pixel(q->code)]) * double(window[view][q->corner]));
     if (score > best_score) best_score = score, code = q->code;
   }
   return code;
