@@ -724,6 +724,36 @@ TEST(Solid, HistogramValuesAreTheExemplarsTexelsAtTheirSource) {
   }
 }
 
+// Sizes that are not multiples of the passes' 8 x 8 voxel tiles, odd sizes
+// whose wrapped edge gives a voxel one covering window more per axis than
+// n/2, and an odd window: every voxel is still the exemplar texel its source
+// names (the proposals fit max_proposals; ASan in the sanitizer tier), and
+// one round is still exactly the plain pass.
+TEST(Solid, HistogramValuesOnOddSizesAndWindows) {
+  const Image ex = contrasty_exemplar();
+  for (const int size : {21, 27})
+    for (const int n : {5, 8})
+      for (const bool tileable : {true, false}) {
+        SolidOptions o = histogram_values_options();
+        o.size = size, o.neighborhood = n, o.tileable = tileable, o.iterations = 2;
+        const TextureResult r = synthesize_solid(one_exemplar(ex), o);
+        ASSERT_EQ(r.source.size(), r.texture.voxel_count());
+        for (std::size_t v = 0; v < r.texture.voxel_count(); ++v) {
+          ASSERT_GE(r.source[v], 0) << "size " << size << ", n " << n << ", voxel " << v;
+          const std::size_t pix = std::size_t(r.source[v]) & ((std::size_t(1) << 28) - 1);
+          ASSERT_LT(pix, ex.pixel_count());
+          for (int c = 0; c < 3; ++c)
+            ASSERT_EQ(r.texture.values()[v * 3 + c], ex.data()[pix * 3 + c]) << "size " << size << ", n " << n;
+        }
+        o.histogram_value_rounds = 1;
+        SolidOptions plain = o;
+        plain.histogram_values = 0.0;
+        const TextureResult a = synthesize_solid(one_exemplar(ex), o), b = synthesize_solid(one_exemplar(ex), plain);
+        EXPECT_EQ(a.texture.values(), b.texture.values()) << "size " << size << ", n " << n << ", tileable " << tileable;
+        EXPECT_EQ(a.source, b.source);
+      }
+}
+
 TEST(Solid, SolidsDefaultToHistogramValues) {
   EXPECT_EQ(SolidOptions{}.histogram_values, kSolidHistogramValues);
   EXPECT_GT(kSolidHistogramValues, 0.0);
