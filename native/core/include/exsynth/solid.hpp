@@ -58,10 +58,11 @@ constexpr double kSolidFeatureWeight = 3.0;
 /// Solids' histogram_values (SolidOptions): the exemplar values match the
 /// exemplars' histogram. On 64^3 slices of 8 exemplars (feature weight 2) it changes those whose
 /// plain values miss the histogram (stone33: contrast 0.76 -> 0.89, hist_emd
-/// 10.8 -> 7.3; granite1, brick, slate, brownground), for 12-31 % more time
-/// at 128^3 there; where the plain values already match (crackedground,
-/// marble1) the plain pass writes at its own cost (docs/solid.md, eleventh
-/// pass). The first step; a round that overshoots halves it.
+/// 10.8 -> 7.3; granite1, brick, slate, brownground), for ~1.5-2 s more CPU
+/// at 128^3 there (~10 % of the solid; twelfth pass); where the plain values
+/// already match (crackedground, marble1) the plain pass writes at its own
+/// cost (docs/solid.md, eleventh pass). The first step; a round that
+/// overshoots halves it.
 constexpr double kSolidHistogramValues = 0.3;
 
 /// Bins per value channel of TextureOptimizationOptions::histogram_values
