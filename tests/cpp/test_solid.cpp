@@ -9,6 +9,7 @@
 #include <cmath>
 #include <utility>
 #include <limits>
+#include <string>
 
 #include "exsynth/solid.hpp"
 #include "support/cancel.hpp"
@@ -710,18 +711,22 @@ SolidOptions histogram_values_options() {
 
 }  // namespace
 
+// Every voxel of an RGB result is covered and is the exemplar texel its source names.
+static void expect_texels_at_their_source(const TextureResult& r, const Image& ex, const std::string& what) {
+  ASSERT_EQ(r.source.size(), r.texture.voxel_count()) << what;
+  for (std::size_t v = 0; v < r.texture.voxel_count(); ++v) {
+    ASSERT_GE(r.source[v], 0) << what << ": voxel " << v << " was not covered by any window";
+    ASSERT_LT(r.source[v] >> 28, 3) << what;
+    const std::size_t pix = std::size_t(r.source[v]) & ((std::size_t(1) << 28) - 1);
+    ASSERT_LT(pix, ex.pixel_count()) << what;
+    for (int c = 0; c < 3; ++c) ASSERT_EQ(r.texture.values()[v * 3 + c], ex.data()[pix * 3 + c]) << what << ": voxel " << v;
+  }
+}
+
 // histogram_values keeps every voxel an exemplar texel, the one its source names.
 TEST(Solid, HistogramValuesAreTheExemplarsTexelsAtTheirSource) {
   const Image ex = contrasty_exemplar();
-  const TextureResult r = synthesize_solid(one_exemplar(ex), histogram_values_options());
-  ASSERT_EQ(r.source.size(), r.texture.voxel_count());
-  for (std::size_t v = 0; v < r.texture.voxel_count(); ++v) {
-    ASSERT_GE(r.source[v], 0) << "voxel " << v << " was not covered by any window";
-    ASSERT_LT(r.source[v] >> 28, 3);
-    const std::size_t pix = std::size_t(r.source[v]) & ((std::size_t(1) << 28) - 1);
-    ASSERT_LT(pix, ex.pixel_count());
-    for (int c = 0; c < 3; ++c) ASSERT_EQ(r.texture.values()[v * 3 + c], ex.data()[pix * 3 + c]) << "voxel " << v;
-  }
+  expect_texels_at_their_source(synthesize_solid(one_exemplar(ex), histogram_values_options()), ex, "default size");
 }
 
 // Sizes that are not multiples of the passes' 8 x 8 voxel tiles, odd sizes
@@ -736,21 +741,15 @@ TEST(Solid, HistogramValuesOnOddSizesAndWindows) {
       for (const bool tileable : {true, false}) {
         SolidOptions o = histogram_values_options();
         o.size = size, o.neighborhood = n, o.tileable = tileable, o.iterations = 2;
-        const TextureResult r = synthesize_solid(one_exemplar(ex), o);
-        ASSERT_EQ(r.source.size(), r.texture.voxel_count());
-        for (std::size_t v = 0; v < r.texture.voxel_count(); ++v) {
-          ASSERT_GE(r.source[v], 0) << "size " << size << ", n " << n << ", voxel " << v;
-          const std::size_t pix = std::size_t(r.source[v]) & ((std::size_t(1) << 28) - 1);
-          ASSERT_LT(pix, ex.pixel_count());
-          for (int c = 0; c < 3; ++c)
-            ASSERT_EQ(r.texture.values()[v * 3 + c], ex.data()[pix * 3 + c]) << "size " << size << ", n " << n;
-        }
+        const std::string what =
+            "size " + std::to_string(size) + ", n " + std::to_string(n) + (tileable ? ", tileable" : ", clamped");
+        expect_texels_at_their_source(synthesize_solid(one_exemplar(ex), o), ex, what);
         o.histogram_value_rounds = 1;
         SolidOptions plain = o;
         plain.histogram_values = 0.0;
         const TextureResult a = synthesize_solid(one_exemplar(ex), o), b = synthesize_solid(one_exemplar(ex), plain);
-        EXPECT_EQ(a.texture.values(), b.texture.values()) << "size " << size << ", n " << n << ", tileable " << tileable;
-        EXPECT_EQ(a.source, b.source);
+        EXPECT_EQ(a.texture.values(), b.texture.values()) << what;
+        EXPECT_EQ(a.source, b.source) << what;
       }
 }
 

@@ -132,9 +132,10 @@ void LevelSolver::price_factors(const std::vector<double>& price, ValueTables& v
 // float in the plain pass's order and the score is formed in double, so with
 // unit price factors the strict maximum is exactly the plain pass's texel:
 // within the best view only its first best window scores S_max, every other
-// proposal scores below. `out` holds max_proposals() (a raw buffer, not
-// push_back: the vector's end pointer was stored at every proposal, 40 % of
-// this function's samples in perf).
+// proposal scores below. `out` holds max_proposals(): a raw buffer, because
+// with push_back the hottest instruction (40 % of this function's samples in
+// perf) was the vector's end-pointer update after every proposal; without it
+// the function went from 8.6 to 6.4 % of a 128^3 brick solid's CPU.
 std::size_t LevelSolver::value_proposals(const int p[3], Proposal* out) const {
   std::size_t count = 0, first[4] = {0, 0, 0, 0};
   float support[3] = {0.0f, 0.0f, 0.0f}, best[3] = {0.0f, 0.0f, 0.0f};

@@ -57,7 +57,8 @@ class LevelSolver {
   void discrete(StageProgress& progress, std::vector<std::int32_t>* source = nullptr);
 
   /// Bytes of the histogram_values pricing rounds' proposals (SampleProposals)
-  /// for a solid of `voxels` with n x n windows: at most 3 ceil(n/2)^2 per sampled voxel.
+  /// for a solid of `voxels` with n x n windows: 3 ceil(n/2)^2 per sampled voxel
+  /// (one window more per axis where an odd wrapped edge adds one: not counted).
   static double sample_proposal_bytes(double voxels, int n) {
     const double per_view = std::ceil(n / 2.0) * std::ceil(n / 2.0);
     return std::min(voxels, double(kValueSample)) * (3.0 * per_view * sizeof(Proposal) + sizeof(std::uint32_t));
@@ -131,7 +132,7 @@ class LevelSolver {
   // One covering window's proposal for a voxel: the texel it puts there
   // (source_code(view, pixel)), the window's top-left exemplar pixel and its
   // score before prices (the view's summed weight over the voxel times the
-  // window's weight relative to the view's best; see choose_value).
+  // window's weight relative to the view's best; see value_proposals).
   struct Proposal {
     double unpriced;
     std::int32_t code;
@@ -205,7 +206,9 @@ class LevelSolver {
   // rows (y, z), each walked in tiles of kTileX columns: a tile's voxels share
   // the sparse windows of every view (the x-view's slices change along x), so
   // the exemplar-values passes read them from cache. Row by row the x-view
-  // took a new slice's windows at every voxel. Progress: one unit per row.
+  // took a new slice's windows at every voxel (measured on a 128^3 brick
+  // solid: value_proposals 9.2 -> 8.6 % of the CPU; the plain pass within
+  // the noise). Progress: one unit per row.
   static constexpr int kTileRows = 8, kTileX = 8;
   template <class Fn>
   void for_each_voxel_tiled(StageProgress& progress, Fn&& fn) const {
