@@ -230,6 +230,9 @@ LevelSolver::SampleProposals LevelSolver::sample_proposals(const ValueTables& vt
     for (std::size_t c = c0; c < c1; ++c) {
       std::vector<Proposal>& proposals = sample.proposals[c];
       std::vector<std::uint32_t>& ends = sample.ends[c];
+      // The chunk's room at once: no reallocation (and no doubled capacity) as it fills.
+      proposals.reserve(kValueChunk * max_proposals());
+      ends.reserve(kValueChunk);
       for (std::size_t i = c * kValueChunk; i < std::min(M, (c + 1) * kValueChunk); ++i) {
         const std::size_t v = M == N ? i : std::size_t((std::uint64_t(i) * kSpread) % N);
         const int p[3] = {int(v % nx), int((v / nx) % ny), int(v / (nx * ny))};

@@ -157,11 +157,11 @@ class LevelSolver {
   std::size_t value_sample() const;
   ValueTables value_tables() const;
   void price_factors(const std::vector<double>& price, ValueTables& vt) const;
-  // The priced choice; `plain`, when given, receives the unpriced one (the plain pass's).
   std::size_t value_proposals(const int p[3], Proposal* out) const;  // voxel p's, in scan order; their count
   // Room value_proposals needs: the most covering windows of a voxel in each view.
   std::size_t max_proposals() const { return 3 * std::size_t(max_cover_) * std::size_t(max_cover_); }
   std::int32_t priced_choice(const Proposal* begin, const Proposal* end, const ValueTables& vt) const;
+  // The priced choice; `plain`, when given, receives the unpriced one (the plain pass's).
   Choice choose_value(const int p[3], const ValueTables& vt, std::vector<Proposal>& proposals,
                       Choice* plain = nullptr) const;
   SampleProposals sample_proposals(const ValueTables& vt, StageProgress& progress) const;
