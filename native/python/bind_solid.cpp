@@ -179,7 +179,6 @@ void bind_solid(py::module_& m) {
   m.attr("SOLID_DEFAULT_SIZE") = SolidOptions{}.size;
   m.attr("SOLID_DEFAULT_FEATURE_WEIGHT") = SolidOptions{}.feature_weight;
   m.attr("SOLID_DEFAULT_HISTOGRAM_VALUES") = SolidOptions{}.histogram_values;
-  m.attr("SOLID_DEFAULT_HISTOGRAM_BINS") = SolidOptions{}.histogram_bins;
   m.attr("SOLID_MAX_SIZE") = kMaxSolidSize;
   m.attr("IMAGE_MAX_SIZE") = kMaxImageSize;
   m.attr("DEFAULT_MAX_EXEMPLAR_SIZE") = kDefaultMaxExemplarSize;
@@ -232,7 +231,7 @@ without its own. exemplar_y / exemplar_z: the y- and z-slice exemplars (same cha
 views: active slices, 'xyz' or two of them. constraint: (size, size, size, C + 1) float32:
 target values then a weight in [0, 1]. Options (keywords): levels=3, neighborhood=8,
 iterations=3, finest_iterations=-1 (rounds at the finest level; 0 = iterations; -1 = 2 from 64 voxels across), r=0.8, pca_variance=0.95, max_pca_dims=32,
-search='kcoherence'|'kdtree'|'exact', coherence_k=4, random_candidates=2, ann_eps=2.0, histogram_matching=True, histogram_bins=SOLID_DEFAULT_HISTOGRAM_BINS (per channel), histogram_strength=3
+search='kcoherence'|'kdtree'|'exact', coherence_k=4, random_candidates=2, ann_eps=2.0, histogram_matching=True, histogram_bins=16, histogram_strength=3
 ((1 + excess)^-strength re-weighting; 1 = gentle),
 mean_shift=False, coherent_upsampling=True, exemplar_values=True, histogram_values=SOLID_DEFAULT_HISTOGRAM_VALUES (> 0: the
 exemplar values match the exemplars' histogram, this being the step of the per-bin prices; 0 = off), histogram_value_rounds=32

@@ -383,26 +383,7 @@ def test_histogram_values_match_the_exemplars_histogram_with_its_texels():
     assert all(tuple(t) in palette for t in flat(matched).tolist())
     before = quality.hist_emd(ex.astype(np.float64), flat(plain).astype(np.float64))
     after = quality.hist_emd(ex.astype(np.float64), flat(matched).astype(np.float64))
-    assert after < 0.7 * before, (before, after)  # measured 4.66 -> 2.42 (seed 7; 16 histogram bins: 5.35 -> 2.87)
-
-
-def test_solid_histogram_bins_keep_a_light_veined_exemplars_contrast():
-    # The solids' optimiser counts kSolidHistogramBins (32) bins per channel:
-    # granite1's thin light veins share a bin with mid greys at 16, so their
-    # texels are hardly favoured and the slices come out darker and flatter.
-    # Measured at 32^3 (2 levels), slice contrast 16 -> 32 bins: seed 7 0.794
-    # -> 0.890, seed 1 0.787 -> 0.803, seed 2 0.762 -> 0.840.
-    assert _native.SOLID_DEFAULT_HISTOGRAM_BINS == 32
-    ex = exemplar("granite1.png", size=128)
-    E = quality.Exemplar(ex)
-    gains = []
-    for seed in (7, 1, 2):
-        contrast = lambda **o: quality.volume_metrics(
-            E, optimizer_solid(ex, size=32, levels=2, seed=seed, **o)["solid"], slices=4)["mean"]["contrast"]
-        coarse, default = contrast(histogram_bins=16), contrast()
-        assert default > coarse, (seed, coarse, default)
-        gains.append(default - coarse)
-    assert np.mean(gains) > 0.03, gains
+    assert after < 0.7 * before, (before, after)  # measured 5.35 -> 2.87 (seed 7)
 
 
 def test_histogram_values_leave_an_already_matched_solid_as_the_plain_pass():

@@ -65,17 +65,6 @@ constexpr double kSolidFeatureWeight = 3.0;
 /// overshoots halves it.
 constexpr double kSolidHistogramValues = 0.3;
 
-/// Solids' histogram_bins (SolidOptions; images keep 16): the optimiser's
-/// histogram re-weighting counts 32 bins per channel. With 16 a thin light
-/// feature shares its bins with mid values, so its texels are hardly
-/// favoured: granite1's veins were lost (64^3, mean of seeds 7/1/2:
-/// sharpness 0.85 -> 0.90, contrast 0.81 -> 0.87; 128^3, seed 7: 0.84 / 0.82
-/// -> 0.92 / 0.91, hist_emd 3.6 -> 2.4). Over 8 exemplars at seed 7 the
-/// sharpness / contrast / hist_emd targets met go 18 -> 21 of 24 at 64^3 and
-/// 21 -> 23 at 128^3; stone33 at 64^3 is worse (hist_emd 5.2 -> 7.0, three
-/// seeds; 128^3 the same 3.0 / 3.1). docs/solid.md, thirteenth pass.
-constexpr int kSolidHistogramBins = 32;
-
 /// Bins per value channel of TextureOptimizationOptions::histogram_values
 /// (the quality measure's hist_emd uses 32 over the 8-bit range).
 constexpr int kValueBins = 32;
@@ -105,7 +94,7 @@ struct TextureOptimizationOptions {
   int random_candidates = 2;     ///< extra random candidates per search (exploration)
   double ann_eps = 2.0;          ///< KdTree: nanoflann's eps (approximation tolerance)
   bool histogram_matching = true;
-  int histogram_bins = 16;       ///< per channel (solids: kSolidHistogramBins)
+  int histogram_bins = 16;       ///< per channel
   /// Exponent p of the histogram re-weighting: a texel whose bins the output
   /// over-represents by `excess` counts (1 + excess)^-p. 1 = the gentle
   /// weighting of before; 3 (measured, docs/solid.md) keeps the exemplar's
@@ -208,9 +197,8 @@ struct SolidOptions : TextureOptimizationOptions {
   int coordinate_coherence_k = 0;
   SolidOptions() {
     finest_iterations = -1;
-    feature_weight = kSolidFeatureWeight;        // method Coordinates ignores these
+    feature_weight = kSolidFeatureWeight;        // method Coordinates ignores both
     histogram_values = kSolidHistogramValues;
-    histogram_bins = kSolidHistogramBins;
   }
 };
 /// The default method's name (SolidOptions{}.method).
