@@ -24,7 +24,7 @@ SolidSearch to_search(const std::string& s) {
 constexpr const char* kCommonNames =
     "levels, neighborhood, iterations, finest_iterations, r, pca_variance, max_pca_dims, search, coherence_k, "
     "random_candidates, ann_eps, histogram_matching, histogram_bins, histogram_strength, mean_shift, "
-    "coherent_upsampling, exemplar_values, histogram_values, histogram_value_rounds, histogram_value_window, feature_weight, tileable, max_exemplar_size, memory_budget, seed";
+    "coherent_upsampling, exemplar_values, histogram_values, histogram_value_rounds, histogram_value_window, feature_weight, feature_threshold, tileable, max_exemplar_size, memory_budget, seed";
 
 // The options both entry points share, in one place; `names`: every option
 // the entry point takes, for the message about an unknown one.
@@ -54,6 +54,8 @@ void set_common(TextureOptimizationOptions& o, const py::kwargs& kw, const std::
     else if (k == "histogram_value_rounds") o.histogram_value_rounds = int_arg(v, k, 1, 64);
     else if (k == "histogram_value_window") o.histogram_value_window = real_arg(v, k, 0.0, 1.0);
     else if (k == "feature_weight") o.feature_weight = real_arg(v, k, 0.0, 100.0, Ends::Closed, "0 = off");
+    else if (k == "feature_threshold")
+      o.feature_threshold = real_arg(v, k, 0.0, 10.0, Ends::Closed, "0 = darker than the window's mean at all");
     else if (k == "tileable") o.tileable = bool_arg(v, k);
     else if (k == "max_exemplar_size") o.max_exemplar_size = int_arg(v, k, 0, 1 << 16);
     else if (k == "memory_budget") o.memory_budget = memory_budget_arg(v, k);
@@ -236,7 +238,9 @@ search='kcoherence'|'kdtree'|'exact', coherence_k=4, random_candidates=2, ann_ep
 mean_shift=False, coherent_upsampling=True, exemplar_values=True, histogram_values=SOLID_DEFAULT_HISTOGRAM_VALUES (> 0: the
 exemplar values match the exemplars' histogram, this being the step of the per-bin prices; 0 = off), histogram_value_rounds=32
 (its pricing rounds), histogram_value_window=0 (0..1: the share of a proposal's price taken from its whole
-window's texels, for coherent choices), feature_weight=SOLID_DEFAULT_FEATURE_WEIGHT (the feature-distance channel's weight; 0 = off), tileable=True,
+window's texels, for coherent choices), feature_weight=SOLID_DEFAULT_FEATURE_WEIGHT (the feature-distance channel's weight; 0 = off),
+feature_threshold=0 (features: pixels darker than their window's mean by more than this x the exemplar's
+luminance std), tileable=True,
 max_exemplar_size=256 (working resolution: larger exemplars are halved until they fit; 0 = never),
 method=SOLID_DEFAULT_METHOD ('optimization': Kopf et al. 2007; 'coordinates': exemplar coordinates after
 Dong et al. 2008, which uses levels, iterations, finest_iterations, coordinate_coherence_k=0 (0..16), pca_variance, max_pca_dims,

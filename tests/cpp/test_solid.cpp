@@ -573,6 +573,38 @@ TEST(FeatureChannel, FeaturesAreDarkerThanTheirSurroundings) {
   EXPECT_FLOAT_EQ(f.at(50, 20, 1), 1.0f);  // the light half
 }
 
+// feature_threshold t: a feature must be darker than its window's mean by
+// more than t x the exemplar's luminance std. A deep crack and a faint
+// groove on a light ground: at 0 both are features, at 1 only the crack.
+// The reference mask is computed here by brute force (window mean, global std).
+TEST(FeatureChannel, ThresholdKeepsOnlyTheDeepFeatures) {
+  Image img(48, 32, 1, 0.8f);
+  for (int y = 0; y < 32; ++y) {
+    img.at(10, y, 0) = 0.1f;   // crack
+    img.at(34, y, 0) = 0.7f;   // faint groove
+  }
+  const int scale = 4;
+  double sum = 0.0, sum2 = 0.0;
+  for (int y = 0; y < 32; ++y)
+    for (int x = 0; x < 48; ++x) sum += img.at(x, y, 0), sum2 += double(img.at(x, y, 0)) * img.at(x, y, 0);
+  const double n = 48.0 * 32.0, sd = std::sqrt(sum2 / n - (sum / n) * (sum / n));
+  for (double t : {0.0, 1.0}) {
+    const Image f = solid::with_feature_channel(img, 1.0f, scale, t);
+    for (int y = 0; y < 32; y += 5)
+      for (int x = 0; x < 48; ++x) {
+        double mean = 0.0;
+        for (int dy = -scale; dy <= scale; ++dy)
+          for (int dx = -scale; dx <= scale; ++dx)
+            mean += img.at(std::clamp(x + dx, 0, 47), std::clamp(y + dy, 0, 31), 0);
+        mean /= double((2 * scale + 1) * (2 * scale + 1));
+        const bool feature = img.at(x, y, 0) < mean - t * sd;
+        EXPECT_EQ(f.at(x, y, 1) < 0.5f, feature) << "t " << t << " at " << x << "," << y;
+      }
+    EXPECT_LT(f.at(10, 16, 1), 0.5f);                 // the crack: a feature either way
+    EXPECT_EQ(f.at(34, 16, 1) < 0.5f, t == 0.0);      // the groove: only at 0
+  }
+}
+
 TEST(Solid, FeatureChannelGuidesMatchingAndIsDropped) {
   const Image ex = disc_texture(32, 32, 3, 15);
   SolidOptions o = small_options();

@@ -133,6 +133,14 @@ struct TextureOptimizationOptions {
   /// [0, 1]; it guides matching and is dropped from the output. 0 = off
   /// (images' default); solids default to kSolidFeatureWeight.
   double feature_weight = 0.0;
+  /// t >= 0: the feature channel's features are the pixels darker than
+  /// their window's mean by more than t x the exemplar's luminance standard
+  /// deviation (0 = darker at all, the default). At 1 the features are the
+  /// cracks and mortar themselves rather than half of every window, and
+  /// stone33's cow shows stones outlined by a network of cracks; not the
+  /// default yet (brick's hist_emd and every nn_rel get worse,
+  /// crackedground's cells come out elongated; docs/solid.md, thirteenth pass).
+  double feature_threshold = 0.0;
   bool tileable = true;          ///< toroidal boundaries, so the output tiles
   /// Working resolution: an exemplar whose longer edge exceeds this many
   /// pixels is analysed at half, quarter, ... resolution (Gaussian pyramid

@@ -46,9 +46,20 @@ std::vector<float> local_mean(const std::vector<float>& v, int w, int h, int r) 
   return out;
 }
 
+// Standard deviation of the luminance over the whole exemplar.
+double deviation(const std::vector<float>& lum) {
+  double sum = 0.0, sum2 = 0.0;
+  for (float v : lum) {
+    sum += v;
+    sum2 += double(v) * v;
+  }
+  const double mean = sum / double(lum.size());
+  return std::sqrt(std::max(0.0, sum2 / double(lum.size()) - mean * mean));
+}
+
 }  // namespace
 
-Image with_feature_channel(const Image& ex, float weight, int scale) {
+Image with_feature_channel(const Image& ex, float weight, int scale, double threshold) {
   const int w = ex.width(), h = ex.height(), C = ex.channels(), L = std::min(C, 3);
   std::vector<float> lum(ex.pixel_count());
   for (std::size_t p = 0; p < lum.size(); ++p) {
@@ -58,7 +69,8 @@ Image with_feature_channel(const Image& ex, float weight, int scale) {
   }
   const std::vector<float> mean = local_mean(lum, w, h, scale);
   std::vector<std::uint8_t> feature(lum.size());
-  for (std::size_t p = 0; p < lum.size(); ++p) feature[p] = lum[p] < mean[p] ? 1 : 0;
+  const float margin = threshold > 0.0 ? float(threshold * deviation(lum)) : 0.0f;
+  for (std::size_t p = 0; p < lum.size(); ++p) feature[p] = lum[p] < mean[p] - margin ? 1 : 0;
   const std::vector<float> to_feature = distance_to(feature, 1, w, h);
   const std::vector<float> to_background = distance_to(feature, 0, w, h);
 

@@ -14,7 +14,8 @@ namespace exsynth::solid {
 /// half became the whole solid, contrast 0.49; docs/solid.md, ninth pass);
 /// value = weight * (0.5 + 0.5 * clamp(signed distance to the feature edge /
 /// `scale` pixels, -1, 1)), positive outside features. Exact Euclidean
-/// distances (separable transform).
-Image with_feature_channel(const Image& exemplar, float weight, int scale);
+/// distances (separable transform). threshold > 0: a feature must be darker
+/// than that mean by threshold x the exemplar's luminance standard deviation.
+Image with_feature_channel(const Image& exemplar, float weight, int scale, double threshold = 0.0);
 
 }  // namespace exsynth::solid
