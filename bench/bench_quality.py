@@ -5,8 +5,11 @@ For each exemplar (128^2, resampled with Lanczos from the source listed
 below): a 64^3 solid (and with --full a 128^3 one), a 256^2 image, and the
 peer G'MIC `syntexturize_matchpatch 256,256` on the same exemplar, all with
 default options and seed 7. The numbers are exsynth.quality's (see its
-docstring: nn_rel, sharpness, contrast, hist_emd, copy_rate, max_copy_frac);
-solids are the mean over x, y and z slices. Then speed: whole-process time
+docstring: nn_rel, sharpness, contrast, hist_emd, copy_rate, max_copy_frac,
+elongation); solids are the mean over x, y and z slices, but their
+elongation is measured in 3D (1 = features as long for their width as the
+exemplar's; above 1 stretched one way, as parallel sheets or tubes; below 1
+the exemplar's long features, veins or courses, lost). Then speed: whole-process time
 for 128^2 -> 256^2 (the Python module vs the gmic command, alternating in
 the same run, median of 3) and a 128^3 RGB solid.
 
@@ -49,7 +52,9 @@ EXEMPLARS = {  # name: source
     "brownground": os.path.join(ASSIMP, "IRRMesh", "brownground_1-1.jpg"),
 }
 SOLID_ONLY = ("method", "coordinate_coherence_k")  # options synthesize_image does not take
-KEYS = ("nn_rel", "sharpness", "contrast", "hist_emd", "copy_rate", "max_copy_frac")
+KEYS = ("nn_rel", "sharpness", "contrast", "hist_emd", "copy_rate", "max_copy_frac", "elongation")
+WORST = {"nn_rel": max, "hist_emd": max, "copy_rate": max, "max_copy_frac": max, "sharpness": min, "contrast": min,
+         "elongation": lambda v: max(v, key=lambda e: abs(np.log(e)))}  # farthest from 1 either way
 
 
 def read_pat(path):
@@ -186,8 +191,7 @@ def main(argv=None):
     for label, ms in totals.items():
         print(row(f"mean over {len(ms)} exemplars: {label}", {k: float(np.mean([m[k] for m in ms])) for k in KEYS}))
         print(row(f"worst of {len(ms)} exemplars: {label}",
-                  {k: (max if k in ("nn_rel", "hist_emd", "copy_rate", "max_copy_frac") else min)(m[k] for m in ms)
-                   for k in KEYS}))
+                  {k: WORST[k]([m[k] for m in ms]) for k in KEYS}))
 
     if args.solids_only:
         return 0
