@@ -178,6 +178,10 @@ def _parser():
     p.add_argument("--feature-weight", type=_finite, default=_native.SOLID_DEFAULT_FEATURE_WEIGHT,
                    help="with --method optimization: weight of the distance to the exemplar's dark features "
                    "(cracks, mortar) in the matching; higher = crisper, 0 = colours only (default %(default)s)")
+    p.add_argument("--feature-threshold", type=_finite, default=_native.SOLID_DEFAULT_FEATURE_THRESHOLD,
+                   help="with --method optimization: which exemplar pixels are features, in luminance standard "
+                   "deviations below their window's mean; 0 = any darker pixel, ~1 = only deep cracks and mortar "
+                   "(crisper cracks, but cells may stretch along a diagonal) (default %(default)s)")
     p.add_argument("--histogram-values", type=_finite, default=_native.SOLID_DEFAULT_HISTOGRAM_VALUES,
                    help="with --method optimization: how strongly each voxel's exemplar colour is picked to match "
                    "the exemplar's histogram (contrast); above 0.5 it oscillates, 0 = off (default %(default)s)")
@@ -506,6 +510,9 @@ def _run_solid(args):
     _texture_size("--size", (args.size,), args.levels, _native.SOLID_MAX_SIZE, "voxels")
     _require(args.iterations > 0, f"--iterations must be > 0 (got {args.iterations})")
     _require(args.feature_weight >= 0, f"--feature-weight must be >= 0 (got {args.feature_weight}); 0 = off")
+    _require(0 <= args.feature_threshold <= _native.SOLID_MAX_FEATURE_THRESHOLD,
+             f"--feature-threshold must be in 0..{_native.SOLID_MAX_FEATURE_THRESHOLD:g} "
+             f"(got {args.feature_threshold}); 0 = any darker pixel is a feature")
     _require(args.histogram_values >= 0,
              f"--histogram-values must be >= 0 (got {args.histogram_values}); 0 = off")
     _require(args.scale >= 0, f"--scale must be >= 0 (got {args.scale}); 0 picks it from the mesh")
@@ -529,7 +536,8 @@ def _run_solid(args):
     job = solid_ops.SolidJob(
         name=solid_ops.exemplar_name(images[0]), exemplar=exemplar, exemplar_y=exemplar_y,
         exemplar_z=exemplar_z, size=args.size, levels=args.levels, iterations=args.iterations,
-        method=args.method, feature_weight=args.feature_weight, histogram_values=args.histogram_values,
+        method=args.method, feature_weight=args.feature_weight, feature_threshold=args.feature_threshold,
+        histogram_values=args.histogram_values,
         scale=scale, seed=args.seed,
         memory_budget=int(args.memory_budget * GIB), encoding=encoding,
         anchor=anchor, targets=targets, bake=solid_ops.BakeOptions(args.bake_size),

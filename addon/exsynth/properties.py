@@ -135,6 +135,15 @@ class ExSynthSettings(bpy.types.PropertyGroup):
         "only. The Coordinates method ignores it",
         default=_native.SOLID_DEFAULT_FEATURE_WEIGHT, min=0.0, max=100.0, soft_max=8.0,
     )
+    solid_feature_threshold: FloatProperty(
+        name="Feature Threshold",
+        description="Which dark pixels of the exemplar count as features for Feature Weight, in the "
+        "exemplar's brightness standard deviations below their neighbourhood: 0 = any darker pixel "
+        "(soft, isotropic cells); about 1 = only deep cracks and mortar (a crisper crack network, but "
+        "cells and stones may come out stretched along one diagonal). The Coordinates method ignores it",
+        default=_native.SOLID_DEFAULT_FEATURE_THRESHOLD, min=0.0, max=_native.SOLID_MAX_FEATURE_THRESHOLD,
+        soft_max=2.0,
+    )
     solid_histogram_values: FloatProperty(
         name="Histogram Values",
         description="How strongly the Optimization method picks each voxel's exemplar colour so that the solid "

@@ -164,6 +164,23 @@ def test_solid_feature_weight(tmp_path, capsys):
     assert not (tmp_path / "bad.npy").exists()
 
 
+def test_solid_feature_threshold(tmp_path, capsys):
+    out = tmp_path / "t.npy"
+    code, err = run(capsys, "solid", "--exemplar", CRACKED, "--size", "16", "--levels", "2", "--iterations", "1",
+                    "--feature-threshold", "1", "--out", str(out))
+    assert code == 0, err
+    ex = solid_ops.read_exemplars(image_io.load(CRACKED))[0]
+    direct = lambda t: _native.synthesize_solid(ex, size=16, levels=2, iterations=1, seed=0,
+                                                feature_threshold=t)["solid"]
+    np.testing.assert_allclose(np.load(out), direct(1.0), atol=1e-6)
+    assert not np.array_equal(np.load(out), direct(0.0))
+    for value in ("-1", "11"):
+        code, err = run(capsys, "solid", "--exemplar", CRACKED, *FAST_SOLID, "--feature-threshold", value,
+                        "--out", str(tmp_path / "bad.npy"))
+        assert code != 0 and f"--feature-threshold must be in 0..10 (got {float(value)})" in err, err
+    assert not (tmp_path / "bad.npy").exists()
+
+
 def test_solid_histogram_values(tmp_path, capsys):
     out = tmp_path / "h.npy"
     code, err = run(capsys, "solid", "--exemplar", CRACKED, "--size", "16", "--levels", "2", "--iterations", "1",

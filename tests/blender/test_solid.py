@@ -678,3 +678,17 @@ def test_feature_weight_defaults_to_the_engines_and_reaches_it(cow, exemplar):
     direct = _native.synthesize_solid(ex, size=16, levels=2, iterations=2, seed=settings().seed,
                                       method="optimization", feature_weight=0.0)["solid"]
     np.testing.assert_allclose(plain, direct, atol=1e-6)
+
+
+def test_feature_threshold_defaults_to_the_engines_and_reaches_it(cow, exemplar):
+    assert settings().solid_feature_threshold == pytest.approx(_native.SOLID_DEFAULT_FEATURE_THRESHOLD)
+    rna = settings().bl_rna.properties["solid_feature_threshold"]
+    assert (rna.hard_min, rna.hard_max) == (0.0, pytest.approx(_native.SOLID_MAX_FEATURE_THRESHOLD))
+    settings().solid_feature_threshold = 1.0
+    assert run() == {'FINISHED'}
+    made, _, _ = read_solid(bpy.data.objects["crackedground_solid"])
+    ex = solid_ops.read_exemplars(exemplar)[0]
+    direct = lambda **kw: _native.synthesize_solid(ex, size=16, levels=2, iterations=2, seed=settings().seed,
+                                                   method="optimization", **kw)["solid"]
+    np.testing.assert_allclose(made, direct(feature_threshold=1.0), atol=1e-6)
+    assert not np.array_equal(made, direct(feature_threshold=0.0))  # the value matters here

@@ -149,6 +149,7 @@ class SolidJob(Job):
     iterations: int = _native.DEFAULT_ITERATIONS
     method: str = None              # one of _native.SOLID_METHODS; None = the engine's default
     feature_weight: float = _native.SOLID_DEFAULT_FEATURE_WEIGHT  # the optimiser's; 0 = off
+    feature_threshold: float = _native.SOLID_DEFAULT_FEATURE_THRESHOLD  # which dark pixels are features
     histogram_values: float = _native.SOLID_DEFAULT_HISTOGRAM_VALUES  # the optimiser's; 0 = off
     scale: float = 1.0              # edge length of one tile
     seed: int = 0
@@ -166,7 +167,8 @@ class SolidJob(Job):
             self.exemplar, exemplar_y=self.exemplar_y, exemplar_z=self.exemplar_z, size=self.size,
             levels=self.levels, iterations=self.iterations, seed=self.seed,
             memory_budget=self.memory_budget, ctx=ctx, method=self.method or _native.SOLID_DEFAULT_METHOD,
-            feature_weight=self.feature_weight, histogram_values=self.histogram_values,
+            feature_weight=self.feature_weight, feature_threshold=self.feature_threshold,
+            histogram_values=self.histogram_values,
         )
         solid = Solid(res["solid"], self.scale / self.size, list(res["energy"]))
         baked = bake_targets(solid.values, solid.origin, solid.voxel_size, self.targets, self.bake, ctx,
@@ -355,7 +357,7 @@ class EXSYNTH_OT_solid_texture(JobOperator, bpy.types.Operator):
             exemplar_y=exemplar_y, exemplar_z=exemplar_z, size=settings.solid_size,
             levels=settings.solid_levels, iterations=settings.solid_iterations,
             method=settings.solid_method.lower(), feature_weight=settings.solid_feature_weight,
-            histogram_values=settings.solid_histogram_values,
+            feature_threshold=settings.solid_feature_threshold, histogram_values=settings.solid_histogram_values,
             scale=settings.solid_scale, seed=settings.seed,
             memory_budget=settings.memory_budget_bytes, encoding=encoding, anchor=anchor,
             targets=targets, bake=BakeOptions(settings.solid_bake_resolution),

@@ -82,6 +82,9 @@ class EXSYNTH_PT_solid_advanced(SidebarPanel, bpy.types.Panel):
         col = layout.column()
         col.active = settings.solid_method == 'OPTIMIZATION'  # the other method ignores them
         col.prop(settings, "solid_feature_weight")
+        row = col.row()
+        row.active = settings.solid_feature_weight > 0  # the threshold picks the features the weight weighs
+        row.prop(settings, "solid_feature_threshold")
         col.prop(settings, "solid_histogram_values")
         draw_shared_advanced(layout, context.scene.exsynth)
 

@@ -29,6 +29,9 @@ namespace exsynth {
 constexpr int kDefaultMaxExemplarSize = 256;
 /// Largest output edge: solids (size^3 voxels) and images (pixels).
 constexpr int kMaxSolidSize = 2048;
+/// Upper end of TextureOptimizationOptions::feature_threshold (in exemplar
+/// luminance standard deviations: no pixel is that far below its window's mean).
+constexpr double kMaxFeatureThreshold = 10.0;
 constexpr int kMaxImageSize = 16384;
 
 /// Smallest output edge (voxels or pixels) the optimiser accepts with these
@@ -138,8 +141,9 @@ struct TextureOptimizationOptions {
   /// deviation (0 = darker at all, the default). At 1 the features are the
   /// cracks and mortar themselves rather than half of every window, and
   /// stone33's cow shows stones outlined by a network of cracks; not the
-  /// default yet (brick's hist_emd and every nn_rel get worse,
-  /// crackedground's cells come out elongated; docs/solid.md, thirteenth pass).
+  /// default (brick's hist_emd and every nn_rel get worse, and
+  /// crackedground's cells come out as parallel sheets: docs/solid.md,
+  /// thirteenth and fourteenth passes). Up to kMaxFeatureThreshold.
   double feature_threshold = 0.0;
   bool tileable = true;          ///< toroidal boundaries, so the output tiles
   /// Working resolution: an exemplar whose longer edge exceeds this many

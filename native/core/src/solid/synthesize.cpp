@@ -42,7 +42,7 @@ void check_options(const TextureOptimizationOptions& o) {
   range("histogram_bins", o.histogram_bins, 2, 256, "");
   range("histogram_strength", o.histogram_strength, 0, 16, " (1 = the gentle weighting, 3 = default)");
   range("feature_weight", o.feature_weight, 0, 100, " (0 = off)");
-  range("feature_threshold", o.feature_threshold, 0, 10, " (0 = darker than the window's mean at all)");
+  range("feature_threshold", o.feature_threshold, 0, kMaxFeatureThreshold, " (0 = darker than the window's mean at all)");
   range("histogram_values", o.histogram_values, 0, 100, " (0 = off)");
   range("histogram_value_rounds", o.histogram_value_rounds, 1, 64, "");
   range("histogram_value_window", o.histogram_value_window, 0, 1, " (0 = each texel's own price)");
