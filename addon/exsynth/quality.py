@@ -116,12 +116,26 @@ def autocorrelation(a):
     return np.fft.fftshift(ac / max(ac.flat[0], 1e-30))
 
 
-def lobe_stretch(a, lobe_level=0.3):
+def gaussian_blur(a, sigma):
+    """a low-passed by a Gaussian of `sigma` pixels (periodic, in Fourier space)."""
+    F = np.fft.fftn(np.asarray(a, np.float64))
+    for ax, n in enumerate(F.shape):
+        g = np.exp(-2.0 * (np.pi * sigma * np.fft.fftfreq(n)) ** 2)
+        F *= g.reshape([n if i == ax else 1 for i in range(F.ndim)])
+    return np.fft.ifftn(F).real
+
+
+def lobe_stretch(a, lobe_level=0.3, sigma=1.0):
     """sqrt(largest / smallest eigenvalue) of the second moments (weighted by
     the autocorrelation) of the autocorrelation's central lobe: the
     connected region above lobe_level around lag 0, grown face-neighbour by
-    face-neighbour. 1 = isotropic."""
-    ac = autocorrelation(a)
+    face-neighbour. 1 = isotropic.
+
+    `a` is blurred by a Gaussian of `sigma` pixels first, so that the lobe
+    holds at least the face neighbours of lag 0 on any grain: slate's
+    correlation at a lag of 1 pixel is 0.21, and unblurred its lobe (and a
+    64^3 marble1 solid's) was the lag-0 point alone, the stretch undefined."""
+    ac = autocorrelation(gaussian_blur(a, sigma) if sigma > 0 else a)
     centre = tuple(n // 2 for n in ac.shape)
     above = ac > lobe_level
     lobe = np.zeros_like(above)

@@ -44,6 +44,14 @@ def test_isotropic_blobs_are_not_stretched_and_stretched_ones_are():
     assert quality.lobe_stretch(rows.T) == pytest.approx(quality.lobe_stretch(rows), rel=1e-9)
 
 
+@pytest.mark.parametrize("shape", [(64, 64), (24, 24, 24)])
+def test_white_noise_is_isotropic_not_undefined(shape):
+    # No correlation at a lag of one pixel (as on slate's fine grain): the
+    # lobe must still span more than lag 0.
+    noise = np.random.default_rng(1).random(shape)
+    assert 1.0 <= quality.lobe_stretch(noise) < 1.3
+
+
 def test_a_solid_of_tubes_is_elongated_in_3d_beyond_what_its_slices_show():
     # Isotropic blobs smeared along the (1, 1, 1) diagonal: tubes. An axis
     # slice cuts them at 55 degrees, so it shows ellipses at most sqrt(3)
