@@ -182,6 +182,10 @@ def _parser():
                    help="with --method optimization: which exemplar pixels are features, in luminance standard "
                    "deviations below their window's mean; 0 = any darker pixel, ~1 = only deep cracks and mortar "
                    "(crisper cracks, but cells may stretch along a diagonal) (default %(default)s)")
+    p.add_argument("--rotate-exemplar", action="store_true",
+                   help="with --method optimization: also match the exemplar turned by 90, 180 and 270 degrees, "
+                   "for textures with no preferred direction (cracks, stones), whose cells otherwise line up along "
+                   "one diagonal; not for wood or bricks; about 2-3x slower")
     p.add_argument("--histogram-values", type=_finite, default=_native.SOLID_DEFAULT_HISTOGRAM_VALUES,
                    help="with --method optimization: how strongly each voxel's exemplar colour is picked to match "
                    "the exemplar's histogram (contrast); above 0.5 it oscillates, 0 = off (default %(default)s)")
@@ -537,7 +541,7 @@ def _run_solid(args):
         name=solid_ops.exemplar_name(images[0]), exemplar=exemplar, exemplar_y=exemplar_y,
         exemplar_z=exemplar_z, size=args.size, levels=args.levels, iterations=args.iterations,
         method=args.method, feature_weight=args.feature_weight, feature_threshold=args.feature_threshold,
-        histogram_values=args.histogram_values,
+        rotate_exemplar=args.rotate_exemplar, histogram_values=args.histogram_values,
         scale=scale, seed=args.seed,
         memory_budget=int(args.memory_budget * GIB), encoding=encoding,
         anchor=anchor, targets=targets, bake=solid_ops.BakeOptions(args.bake_size),

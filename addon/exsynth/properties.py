@@ -144,6 +144,14 @@ class ExSynthSettings(bpy.types.PropertyGroup):
         default=_native.SOLID_DEFAULT_FEATURE_THRESHOLD, min=0.0, max=_native.SOLID_MAX_FEATURE_THRESHOLD,
         soft_max=2.0,
     )
+    solid_rotate_exemplar: BoolProperty(
+        name="Rotate Exemplar",
+        description="Also match the exemplar turned by 90, 180 and 270 degrees: for textures with no preferred "
+        "direction (cracks, stones, granite), whose cells and stones otherwise line up along one diagonal, most "
+        "with a Feature Threshold near 1. Not for wood grain, bricks or anything that runs one way. About 2-3x "
+        "slower. The Coordinates method ignores it",
+        default=_native.SOLID_DEFAULT_ROTATE_EXEMPLAR,
+    )
     solid_histogram_values: FloatProperty(
         name="Histogram Values",
         description="How strongly the Optimization method picks each voxel's exemplar colour so that the solid "

@@ -24,7 +24,7 @@ SolidSearch to_search(const std::string& s) {
 constexpr const char* kCommonNames =
     "levels, neighborhood, iterations, finest_iterations, r, pca_variance, max_pca_dims, search, coherence_k, "
     "random_candidates, ann_eps, histogram_matching, histogram_bins, histogram_strength, mean_shift, "
-    "coherent_upsampling, exemplar_values, histogram_values, histogram_value_rounds, histogram_value_window, feature_weight, feature_threshold, tileable, max_exemplar_size, memory_budget, seed";
+    "coherent_upsampling, exemplar_values, histogram_values, histogram_value_rounds, histogram_value_window, feature_weight, feature_threshold, rotate_exemplar, tileable, max_exemplar_size, memory_budget, seed";
 
 // The options both entry points share, in one place; `names`: every option
 // the entry point takes, for the message about an unknown one.
@@ -56,6 +56,7 @@ void set_common(TextureOptimizationOptions& o, const py::kwargs& kw, const std::
     else if (k == "feature_weight") o.feature_weight = real_arg(v, k, 0.0, 100.0, Ends::Closed, "0 = off");
     else if (k == "feature_threshold")
       o.feature_threshold = real_arg(v, k, 0.0, kMaxFeatureThreshold, Ends::Closed, "0 = darker than the window's mean at all");
+    else if (k == "rotate_exemplar") o.rotate_exemplar = bool_arg(v, k);
     else if (k == "tileable") o.tileable = bool_arg(v, k);
     else if (k == "max_exemplar_size") o.max_exemplar_size = int_arg(v, k, 0, 1 << 16);
     else if (k == "memory_budget") o.memory_budget = memory_budget_arg(v, k);
@@ -183,6 +184,7 @@ void bind_solid(py::module_& m) {
   m.attr("SOLID_DEFAULT_HISTOGRAM_VALUES") = SolidOptions{}.histogram_values;
   m.attr("SOLID_DEFAULT_FEATURE_THRESHOLD") = SolidOptions{}.feature_threshold;
   m.attr("SOLID_MAX_FEATURE_THRESHOLD") = kMaxFeatureThreshold;
+  m.attr("SOLID_DEFAULT_ROTATE_EXEMPLAR") = SolidOptions{}.rotate_exemplar;
   m.attr("SOLID_MAX_SIZE") = kMaxSolidSize;
   m.attr("IMAGE_MAX_SIZE") = kMaxImageSize;
   m.attr("DEFAULT_MAX_EXEMPLAR_SIZE") = kDefaultMaxExemplarSize;
@@ -242,11 +244,13 @@ exemplar values match the exemplars' histogram, this being the step of the per-b
 (its pricing rounds), histogram_value_window=0 (0..1: the share of a proposal's price taken from its whole
 window's texels, for coherent choices), feature_weight=SOLID_DEFAULT_FEATURE_WEIGHT (the feature-distance channel's weight; 0 = off),
 feature_threshold=0 (features: pixels darker than their window's mean by more than this x the exemplar's
-luminance std), tileable=True,
+luminance std), rotate_exemplar=False (also the exemplar's 90/180/270-degree turns, for textures
+with no preferred direction: cracks, stones), tileable=True,
 max_exemplar_size=256 (working resolution: larger exemplars are halved until they fit; 0 = never),
 method=SOLID_DEFAULT_METHOD ('optimization': Kopf et al. 2007; 'coordinates': exemplar coordinates after
 Dong et al. 2008, which uses levels, iterations, finest_iterations, coordinate_coherence_k=0 (0..16), pca_variance, max_pca_dims,
-max_exemplar_size, tileable, memory_budget and seed (feature_weight and histogram_values do not apply), and takes no constraint),
+max_exemplar_size, tileable, memory_budget and seed (feature_weight, feature_threshold, rotate_exemplar and histogram_values
+do not apply), and takes no constraint),
 memory_budget=0 (default), seed=0. size: min_texture_size(levels, neighborhood) .. SOLID_MAX_SIZE.
 Returns {'solid': (Z, Y, X, C) float32, 'energy': [...], 'energy_level': [...]}.)doc");
 

@@ -181,6 +181,22 @@ def test_solid_feature_threshold(tmp_path, capsys):
     assert not (tmp_path / "bad.npy").exists()
 
 
+def test_solid_rotate_exemplar(tmp_path, capsys):
+    out = tmp_path / "r.npy"
+    code, err = run(capsys, "solid", "--exemplar", CRACKED, "--size", "16", "--levels", "2", "--iterations", "1",
+                    "--rotate-exemplar", "--out", str(out))
+    assert code == 0, err
+    ex = solid_ops.read_exemplars(image_io.load(CRACKED))[0]
+    direct = lambda rotate: _native.synthesize_solid(ex, size=16, levels=2, iterations=1, seed=0,
+                                                     rotate_exemplar=rotate)["solid"]
+    np.testing.assert_allclose(np.load(out), direct(True), atol=1e-6)
+    assert not np.array_equal(np.load(out), direct(False))
+    code, err = run(capsys, "solid", "--exemplar", CRACKED, *FAST_SOLID, "--rotate-exemplar", "yes",
+                    "--out", str(tmp_path / "bad.npy"))
+    assert code == 2 and "unrecognized arguments: yes" in err, err
+    assert not (tmp_path / "bad.npy").exists()
+
+
 def test_solid_histogram_values(tmp_path, capsys):
     out = tmp_path / "h.npy"
     code, err = run(capsys, "solid", "--exemplar", CRACKED, "--size", "16", "--levels", "2", "--iterations", "1",

@@ -692,3 +692,15 @@ def test_feature_threshold_defaults_to_the_engines_and_reaches_it(cow, exemplar)
                                                    method="optimization", **kw)["solid"]
     np.testing.assert_allclose(made, direct(feature_threshold=1.0), atol=1e-6)
     assert not np.array_equal(made, direct(feature_threshold=0.0))  # the value matters here
+
+
+def test_rotate_exemplar_defaults_to_the_engines_and_reaches_it(cow, exemplar):
+    assert settings().solid_rotate_exemplar is _native.SOLID_DEFAULT_ROTATE_EXEMPLAR is False
+    settings().solid_rotate_exemplar = True
+    assert run() == {'FINISHED'}
+    made, _, _ = read_solid(bpy.data.objects["crackedground_solid"])
+    ex = solid_ops.read_exemplars(exemplar)[0]
+    direct = lambda **kw: _native.synthesize_solid(ex, size=16, levels=2, iterations=2, seed=settings().seed,
+                                                   method="optimization", **kw)["solid"]
+    np.testing.assert_allclose(made, direct(rotate_exemplar=True), atol=1e-6)
+    assert not np.array_equal(made, direct(rotate_exemplar=False))

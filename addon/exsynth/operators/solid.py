@@ -150,6 +150,7 @@ class SolidJob(Job):
     method: str = None              # one of _native.SOLID_METHODS; None = the engine's default
     feature_weight: float = _native.SOLID_DEFAULT_FEATURE_WEIGHT  # the optimiser's; 0 = off
     feature_threshold: float = _native.SOLID_DEFAULT_FEATURE_THRESHOLD  # which dark pixels are features
+    rotate_exemplar: bool = _native.SOLID_DEFAULT_ROTATE_EXEMPLAR  # also its quarter turns
     histogram_values: float = _native.SOLID_DEFAULT_HISTOGRAM_VALUES  # the optimiser's; 0 = off
     scale: float = 1.0              # edge length of one tile
     seed: int = 0
@@ -168,7 +169,7 @@ class SolidJob(Job):
             levels=self.levels, iterations=self.iterations, seed=self.seed,
             memory_budget=self.memory_budget, ctx=ctx, method=self.method or _native.SOLID_DEFAULT_METHOD,
             feature_weight=self.feature_weight, feature_threshold=self.feature_threshold,
-            histogram_values=self.histogram_values,
+            rotate_exemplar=self.rotate_exemplar, histogram_values=self.histogram_values,
         )
         solid = Solid(res["solid"], self.scale / self.size, list(res["energy"]))
         baked = bake_targets(solid.values, solid.origin, solid.voxel_size, self.targets, self.bake, ctx,
@@ -357,7 +358,8 @@ class EXSYNTH_OT_solid_texture(JobOperator, bpy.types.Operator):
             exemplar_y=exemplar_y, exemplar_z=exemplar_z, size=settings.solid_size,
             levels=settings.solid_levels, iterations=settings.solid_iterations,
             method=settings.solid_method.lower(), feature_weight=settings.solid_feature_weight,
-            feature_threshold=settings.solid_feature_threshold, histogram_values=settings.solid_histogram_values,
+            feature_threshold=settings.solid_feature_threshold, rotate_exemplar=settings.solid_rotate_exemplar,
+            histogram_values=settings.solid_histogram_values,
             scale=settings.solid_scale, seed=settings.seed,
             memory_budget=settings.memory_budget_bytes, encoding=encoding, anchor=anchor,
             targets=targets, bake=BakeOptions(settings.solid_bake_resolution),

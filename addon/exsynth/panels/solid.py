@@ -85,6 +85,7 @@ class EXSYNTH_PT_solid_advanced(SidebarPanel, bpy.types.Panel):
         row = col.row()
         row.active = settings.solid_feature_weight > 0  # the threshold picks the features the weight weighs
         row.prop(settings, "solid_feature_threshold")
+        col.prop(settings, "solid_rotate_exemplar")
         col.prop(settings, "solid_histogram_values")
         draw_shared_advanced(layout, context.scene.exsynth)
 

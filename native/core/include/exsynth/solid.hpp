@@ -145,6 +145,12 @@ struct TextureOptimizationOptions {
   /// crackedground's cells come out as parallel sheets: docs/solid.md,
   /// thirteenth and fourteenth passes). Up to kMaxFeatureThreshold.
   double feature_threshold = 0.0;
+  /// The exemplar is used in its four quarter turns (its central square,
+  /// as one mosaic): for textures with no preferred direction (cracks,
+  /// stones, granite), whose cells otherwise line up as parallel sheets,
+  /// most at feature_threshold 1; not for wood, bricks or anything that runs
+  /// one way. Costs 4x the exemplar analysis (docs/solid.md, fourteenth pass).
+  bool rotate_exemplar = false;
   bool tileable = true;          ///< toroidal boundaries, so the output tiles
   /// Working resolution: an exemplar whose longer edge exceeds this many
   /// pixels is analysed at half, quarter, ... resolution (Gaussian pyramid

@@ -14,6 +14,7 @@
 #include "exsynth/solid.hpp"
 #include "solid/coordinate_synthesis.hpp"
 #include "solid/exemplar_index.hpp"
+#include "solid/exemplar_rotations.hpp"
 #include "solid/feature_channel.hpp"
 #include "solid/level_solver.hpp"
 
@@ -133,7 +134,7 @@ struct PreparedExemplars {
   int user_channels = 0, channels = 0;      // channels counts the feature channel
   int exponent = 0;                         // values were scaled by 2^-exponent
   const Volume* constraint = nullptr;       // the job's, scaled like the exemplars
-  std::vector<Image> working, scaled, featured;
+  std::vector<Image> working, scaled, featured, rotated;
   Volume scaled_constraint;
 
   PreparedExemplars() = default;
@@ -205,6 +206,15 @@ void prepare_exemplars(const Job& job, const TextureOptimizationOptions& opt, Pr
       p.featured.push_back(solid::with_feature_channel(*img, float(opt.feature_weight), opt.neighborhood, opt.feature_threshold));
     for (std::size_t e = 0; e < p.images.size(); ++e) p.images[e] = &p.featured[e];
     ++p.channels;
+  }
+  // Last, so the feature channel is the one of the whole exemplar, turned
+  // with it (its square window and Euclidean distances turn exactly).
+  if (opt.rotate_exemplar) {
+    p.rotated.reserve(p.images.size());
+    for (const Image*& img : p.images) {
+      p.rotated.push_back(solid::quarter_turn_mosaic(*img));
+      img = &p.rotated.back();
+    }
   }
 }
 
