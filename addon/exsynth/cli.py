@@ -185,7 +185,7 @@ def _parser():
     p.add_argument("--rotate-exemplar", action="store_true",
                    help="with --method optimization: also match the exemplar turned by 90, 180 and 270 degrees, "
                    "for textures with no preferred direction (cracks, stones), whose cells otherwise line up along "
-                   "one diagonal; not for wood or bricks; about 2-3x slower")
+                   "one diagonal; not for wood or bricks; about 1.4x the time at --size 128, 3x at 64")
     p.add_argument("--histogram-values", type=_finite, default=_native.SOLID_DEFAULT_HISTOGRAM_VALUES,
                    help="with --method optimization: how strongly each voxel's exemplar colour is picked to match "
                    "the exemplar's histogram (contrast); above 0.5 it oscillates, 0 = off (default %(default)s)")
