@@ -164,52 +164,42 @@ def test_solid_feature_weight(tmp_path, capsys):
     assert not (tmp_path / "bad.npy").exists()
 
 
-def test_solid_feature_threshold(tmp_path, capsys):
-    out = tmp_path / "t.npy"
+def solid_as_the_engine_makes(tmp_path, capsys, args, option, value, other):
+    """`solid` with `args` on a 16^3 solid is the engine's with option=value, and not with `other`."""
+    out = tmp_path / "o.npy"
     code, err = run(capsys, "solid", "--exemplar", CRACKED, "--size", "16", "--levels", "2", "--iterations", "1",
-                    "--feature-threshold", "1", "--out", str(out))
+                    *args, "--out", str(out))
     assert code == 0, err
     ex = solid_ops.read_exemplars(image_io.load(CRACKED))[0]
-    direct = lambda t: _native.synthesize_solid(ex, size=16, levels=2, iterations=1, seed=0,
-                                                feature_threshold=t)["solid"]
-    np.testing.assert_allclose(np.load(out), direct(1.0), atol=1e-6)
-    assert not np.array_equal(np.load(out), direct(0.0))
+    direct = lambda v: _native.synthesize_solid(ex, size=16, levels=2, iterations=1, seed=0, **{option: v})["solid"]
+    np.testing.assert_allclose(np.load(out), direct(value), atol=1e-6)
+    assert not np.array_equal(np.load(out), direct(other))
+
+
+def refuses(tmp_path, capsys, args, message, code=None):
+    """`solid` with `args` fails with `message` (and `code`, when given) and writes nothing."""
+    bad = tmp_path / "bad.npy"
+    got, err = run(capsys, "solid", "--exemplar", CRACKED, *FAST_SOLID, *args, "--out", str(bad))
+    assert (got == code if code is not None else got != 0) and message in err, err
+    assert not bad.exists()
+
+
+def test_solid_feature_threshold(tmp_path, capsys):
+    solid_as_the_engine_makes(tmp_path, capsys, ["--feature-threshold", "1"], "feature_threshold", 1.0, 0.0)
     for value in ("-1", "11"):
-        code, err = run(capsys, "solid", "--exemplar", CRACKED, *FAST_SOLID, "--feature-threshold", value,
-                        "--out", str(tmp_path / "bad.npy"))
-        assert code != 0 and f"--feature-threshold must be in 0..10 (got {float(value)})" in err, err
-    assert not (tmp_path / "bad.npy").exists()
+        refuses(tmp_path, capsys, ["--feature-threshold", value],
+                f"--feature-threshold must be in 0..10 (got {float(value)})")
 
 
 def test_solid_rotate_exemplar(tmp_path, capsys):
-    out = tmp_path / "r.npy"
-    code, err = run(capsys, "solid", "--exemplar", CRACKED, "--size", "16", "--levels", "2", "--iterations", "1",
-                    "--rotate-exemplar", "--out", str(out))
-    assert code == 0, err
-    ex = solid_ops.read_exemplars(image_io.load(CRACKED))[0]
-    direct = lambda rotate: _native.synthesize_solid(ex, size=16, levels=2, iterations=1, seed=0,
-                                                     rotate_exemplar=rotate)["solid"]
-    np.testing.assert_allclose(np.load(out), direct(True), atol=1e-6)
-    assert not np.array_equal(np.load(out), direct(False))
-    code, err = run(capsys, "solid", "--exemplar", CRACKED, *FAST_SOLID, "--rotate-exemplar", "yes",
-                    "--out", str(tmp_path / "bad.npy"))
-    assert code == 2 and "unrecognized arguments: yes" in err, err
-    assert not (tmp_path / "bad.npy").exists()
+    solid_as_the_engine_makes(tmp_path, capsys, ["--rotate-exemplar"], "rotate_exemplar", True, False)
+    refuses(tmp_path, capsys, ["--rotate-exemplar", "yes"], "unrecognized arguments: yes", code=2)
 
 
 def test_solid_histogram_values(tmp_path, capsys):
-    out = tmp_path / "h.npy"
-    code, err = run(capsys, "solid", "--exemplar", CRACKED, "--size", "16", "--levels", "2", "--iterations", "1",
-                    "--histogram-values", "0.1", "--out", str(out))
-    assert code == 0, err
-    ex = solid_ops.read_exemplars(image_io.load(CRACKED))[0]
-    direct = _native.synthesize_solid(ex, size=16, levels=2, iterations=1, seed=0, histogram_values=0.1)["solid"]
-    np.testing.assert_allclose(np.load(out), direct, atol=1e-6)
+    solid_as_the_engine_makes(tmp_path, capsys, ["--histogram-values", "0.1"], "histogram_values", 0.1, 0.0)
     for value, message in (("-1", "--histogram-values must be >= 0 (got -1.0)"), ("101", "histogram_values")):
-        code, err = run(capsys, "solid", "--exemplar", CRACKED, *FAST_SOLID, "--histogram-values", value,
-                        "--out", str(tmp_path / "bad.npy"))
-        assert code != 0 and message in err, err
-    assert not (tmp_path / "bad.npy").exists()
+        refuses(tmp_path, capsys, ["--histogram-values", value], message)
 
 
 @pytest.mark.parametrize("method", ["coordinates", "optimization"])

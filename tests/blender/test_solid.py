@@ -650,17 +650,23 @@ def test_coordinates_method_refuses_an_exemplar_too_small_for_its_levels(cow, ex
 
 
 # ---- histogram values (the optimiser's histogram-matched exemplar values) ----------------------
+def made_as_the_engine_makes(exemplar, option, value, other):
+    """Runs the operator (its setting already set to `value`): the solid is the
+    engine's with option=value, and the value matters (not the one with `other`)."""
+    assert run() == {'FINISHED'}
+    made, _, _ = read_solid(bpy.data.objects["crackedground_solid"])
+    ex = solid_ops.read_exemplars(exemplar)[0]
+    direct = lambda v: _native.synthesize_solid(ex, size=16, levels=2, iterations=2, seed=settings().seed,
+                                                method="optimization", **{option: v})["solid"]
+    np.testing.assert_allclose(made, direct(value), atol=1e-6)
+    assert not np.array_equal(made, direct(other))
+
+
 def test_histogram_values_default_to_the_engines_and_reach_it(cow, exemplar):
     assert settings().solid_histogram_values == pytest.approx(_native.SOLID_DEFAULT_HISTOGRAM_VALUES)
     assert _native.SOLID_DEFAULT_HISTOGRAM_VALUES > 0
     settings().solid_histogram_values = 0.1
-    assert run() == {'FINISHED'}
-    made, _, _ = read_solid(bpy.data.objects["crackedground_solid"])
-    ex = solid_ops.read_exemplars(exemplar)[0]
-    direct = lambda **kw: _native.synthesize_solid(ex, size=16, levels=2, iterations=2, seed=settings().seed,
-                                                   method="optimization", **kw)["solid"]
-    np.testing.assert_allclose(made, direct(histogram_values=0.1), atol=1e-6)
-    assert not np.array_equal(direct(histogram_values=0.1), direct(histogram_values=0.0))  # the value matters here
+    made_as_the_engine_makes(exemplar, "histogram_values", 0.1, 0.0)
 
 
 # ---- feature weight (the optimiser's feature-distance channel) --------------------------------
@@ -685,22 +691,10 @@ def test_feature_threshold_defaults_to_the_engines_and_reaches_it(cow, exemplar)
     rna = settings().bl_rna.properties["solid_feature_threshold"]
     assert (rna.hard_min, rna.hard_max) == (0.0, pytest.approx(_native.SOLID_MAX_FEATURE_THRESHOLD))
     settings().solid_feature_threshold = 1.0
-    assert run() == {'FINISHED'}
-    made, _, _ = read_solid(bpy.data.objects["crackedground_solid"])
-    ex = solid_ops.read_exemplars(exemplar)[0]
-    direct = lambda **kw: _native.synthesize_solid(ex, size=16, levels=2, iterations=2, seed=settings().seed,
-                                                   method="optimization", **kw)["solid"]
-    np.testing.assert_allclose(made, direct(feature_threshold=1.0), atol=1e-6)
-    assert not np.array_equal(made, direct(feature_threshold=0.0))  # the value matters here
+    made_as_the_engine_makes(exemplar, "feature_threshold", 1.0, 0.0)
 
 
 def test_rotate_exemplar_defaults_to_the_engines_and_reaches_it(cow, exemplar):
     assert settings().solid_rotate_exemplar is _native.SOLID_DEFAULT_ROTATE_EXEMPLAR is False
     settings().solid_rotate_exemplar = True
-    assert run() == {'FINISHED'}
-    made, _, _ = read_solid(bpy.data.objects["crackedground_solid"])
-    ex = solid_ops.read_exemplars(exemplar)[0]
-    direct = lambda **kw: _native.synthesize_solid(ex, size=16, levels=2, iterations=2, seed=settings().seed,
-                                                   method="optimization", **kw)["solid"]
-    np.testing.assert_allclose(made, direct(rotate_exemplar=True), atol=1e-6)
-    assert not np.array_equal(made, direct(rotate_exemplar=False))
+    made_as_the_engine_makes(exemplar, "rotate_exemplar", True, False)
