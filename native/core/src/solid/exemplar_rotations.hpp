@@ -5,7 +5,7 @@
 // up in 3D: the three slice views agree on a stretched direction only along
 // one diagonal, and the optimiser amplifies the exemplar's slight lean there
 // into parallel sheets (crackedground at feature_threshold 1: 3D
-// elongation 2.4; docs/solid.md, fourteenth pass). With every quarter turn
+// elongation 2.4-2.5; docs/solid.md, fourteenth pass). With every quarter turn
 // in the candidate pool, each view can match a feature whatever its
 // direction.
 #include "exsynth/grid.hpp"

@@ -254,13 +254,15 @@ void check_texture_memory(const Job& job, const TextureOptimizationOptions& opt,
   const std::string size = job.name == "image" ? std::to_string(job.finest.d[0]) + "x" + std::to_string(job.finest.d[1])
                                                : std::to_string(job.finest.d[0]) + "^3";
   const std::string exemplar = std::to_string(largest->width()) + "x" + std::to_string(largest->height()) + " " +
-                               std::to_string(p.user_channels) + "-channel exemplar";  // as the caller gave it
+                               std::to_string(p.user_channels) + "-channel exemplar" +  // as the caller gave it
+                               (opt.rotate_exemplar ? " mosaic (its four quarter turns, rotate_exemplar)" : "");
   if (exemplar_bytes >= texture_bytes)
     check_memory_budget(texture_bytes + exemplar_bytes, opt.memory_budget,
                         "analysing the " + exemplar + " (" + std::to_string(n) + "x" + std::to_string(n) +
                             " neighbourhoods) for a " + size + " " + job.name,
-                        "the exemplar is too big: give a smaller exemplar or a lower max_exemplar_size (working "
-                        "resolution), fewer channels or a smaller neighbourhood, or raise the memory budget");
+                        std::string("the exemplar is too big: give a smaller exemplar or a lower max_exemplar_size "
+                                    "(working resolution), fewer channels or a smaller neighbourhood") +
+                            (opt.rotate_exemplar ? ", turn rotate_exemplar off" : "") + ", or raise the memory budget");
   else
     check_memory_budget(texture_bytes + exemplar_bytes, opt.memory_budget, "synthesizing a " + size + " " + job.name,
                         "lower the size or raise the memory budget");
