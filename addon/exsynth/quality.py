@@ -253,6 +253,13 @@ def volume_metrics(E, vol, slices=16, block=64, **kw):
         res[name]["max_copy_frac"] = max(m["max_copy_frac"] for m in ms)
     res["mean"] = {key: float(np.mean([res[n][key] for n in "xyz"])) for key in res["x"]}
     res["mean"]["max_copy_frac"] = max(res[n]["max_copy_frac"] for n in "xyz")
-    mid = tuple(slice(max(0, (n - block) // 2), max(0, (n - block) // 2) + block) for n in vol.shape[:3])
-    res["mean"]["elongation"] = lobe_stretch(luminance(as_255(vol[mid]), 3)) / E.stretch
+    res["mean"]["elongation"] = volume_elongation(E, vol, block)
     return res
+
+
+def volume_elongation(E, vol, block=64):
+    """The elongation of a (Z, Y, X[, C]) volume in 3D, on its middle block^3
+    (at most), against exemplar E (see the module's docstring)."""
+    vol = np.asarray(vol)
+    mid = tuple(slice(max(0, (n - block) // 2), max(0, (n - block) // 2) + block) for n in vol.shape[:3])
+    return lobe_stretch(luminance(as_255(vol[mid]), 3)) / E.stretch

@@ -458,9 +458,8 @@ def test_rotated_exemplar_keeps_deep_cracks_from_lining_up():
     E = quality.Exemplar(ex)
 
     def elongation(rotate):
-        return np.mean([quality.lobe_stretch(quality.luminance(optimizer_solid(
-            ex, size=32, seed=seed, feature_threshold=1.0, rotate_exemplar=rotate)["solid"], 3)) / E.stretch
-            for seed in (1, 2, 3)])
+        return np.mean([quality.volume_elongation(E, optimizer_solid(
+            ex, size=32, seed=seed, feature_threshold=1.0, rotate_exemplar=rotate)["solid"]) for seed in (1, 2, 3)])
     plain, rotated = elongation(False), elongation(True)
     assert rotated < 1.25 and rotated < plain - 0.2, (plain, rotated)
     # The default leaves the exemplar as given.
