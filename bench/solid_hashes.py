@@ -32,6 +32,7 @@ cases = [
     ("solid48_histvalues", lambda: _native.synthesize_solid(ex, size=48, seed=12, histogram_values=0.1, histogram_value_window=0.5)),
     ("solid48_granite_priced", lambda: _native.synthesize_solid(granite, size=48, seed=13)),
     ("solid40_granite_window", lambda: _native.synthesize_solid(granite, size=40, seed=14, histogram_value_window=0.5)),
+    ("solid48_rotate_t1", lambda: _native.synthesize_solid(ex, size=48, seed=15, feature_threshold=1, rotate_exemplar=True)),
     ("image128_opt", lambda: _native.synthesize_image(ex, width=128, height=128, seed=1, method="optimization")),
     ("image96_opt_tile", lambda: _native.synthesize_image(ex, width=96, height=80, seed=2, method="optimization", tileable=True)),
     ("coord64", lambda: _native.synthesize_solid(ex, size=64, seed=1, method="coordinates")),

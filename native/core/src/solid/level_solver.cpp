@@ -4,9 +4,11 @@
 #include <cmath>
 #include <limits>
 #include <numeric>
+#include <optional>
 
 #include "exsynth/parallel.hpp"
 #include "exsynth/rng.hpp"
+#include "search/exhaustive_nearest.hpp"
 #include "solid/candidate_scoring.hpp"
 
 namespace exsynth::solid {
@@ -166,7 +168,12 @@ double LevelSolver::search(int iteration, bool exhaustive, StageProgress& progre
     };
     const std::size_t batch = kBatch;
     const std::size_t batches = (w.size() + batch - 1) / batch;
+    // Every window (in PCA space) is a candidate: one GEMM per batch.
+    const bool all_windows = exhaustive && opt_.search != SolidSearch::Exact && opt_.search != SolidSearch::KdTree;
+    std::optional<search::ExhaustiveNearest> every_window;
+    if (all_windows) every_window.emplace(ex.coefficients());
     parallel_chunks(batches, 1, progress, [&](std::size_t b0, std::size_t b1) {
+      RowMatrixXf products;  // the exhaustive search's q . c, per batch
       RowMatrixXf x(batch, D), centred(opt_.search != SolidSearch::Exact ? batch : 0, D);
       RowMatrixXf y(opt_.search != SolidSearch::Exact ? batch : 0, ex.pca().basis.cols());
       std::vector<std::size_t> order(batch);
@@ -267,6 +274,7 @@ double LevelSolver::search(int iteration, bool exhaustive, StageProgress& progre
           centred.topRows(r) = x.topRows(r).rowwise() - ex.pca().mean;
           y.topRows(r).noalias() = centred.topRows(r) * ex.pca().basis;
         }
+        if (all_windows) every_window->nearest(y, Eigen::Index(rows), best_of.data(), products);
         const bool coherence = opt_.search == SolidSearch::KCoherence && !exhaustive;
         if (coherence)
           for (std::size_t k = 0; k < std::min(kAhead, rows); ++k) candidates(order[k], cand_of[k % (kAhead + 1)]);
@@ -282,7 +290,7 @@ double LevelSolver::search(int iteration, bool exhaustive, StageProgress& progre
           } else if (opt_.search == SolidSearch::KdTree) {
             best = int(w.kd->nearest(y.row(Eigen::Index(k)).data(), float(opt_.ann_eps)));
           } else if (exhaustive) {
-            ((ex.coefficients().rowwise() - y.row(Eigen::Index(k))).rowwise().squaredNorm()).minCoeff(&best);
+            best = best_of[k];
           } else {
             // The next query's candidates first (their loads overlap this
             // query's scoring; reads only the previous round's matches).
