@@ -182,10 +182,12 @@ def _parser():
                    help="with --method optimization: which exemplar pixels are features, in luminance standard "
                    "deviations below their window's mean; 0 = any darker pixel, ~1 = only deep cracks and mortar "
                    "(crisper cracks, but cells may stretch along a diagonal) (default %(default)s)")
-    p.add_argument("--rotate-exemplar", action="store_true",
+    p.add_argument("--rotate-exemplar", choices=_native.ROTATE_EXEMPLAR_CHOICES, nargs="?",
+                   const="on", default=_native.SOLID_DEFAULT_ROTATE_EXEMPLAR,
                    help="with --method optimization: also match the exemplar turned by 90, 180 and 270 degrees, "
-                   "for textures with no preferred direction (cracks, stones), whose cells otherwise line up along "
-                   "one diagonal; not for wood or bricks; about 1.4x the time at --size 128, 3x at 64")
+                   "for textures with no preferred direction (cracks, cells), whose cells otherwise line up along "
+                   "one diagonal; auto = when the exemplar's features are round, not for wood or bricks; on (the "
+                   "flag alone) = always, about 1.4x the time at --size 128 (default %(default)s)")
     p.add_argument("--histogram-values", type=_finite, default=_native.SOLID_DEFAULT_HISTOGRAM_VALUES,
                    help="with --method optimization: how strongly each voxel's exemplar colour is picked to match "
                    "the exemplar's histogram (contrast); above 0.5 it oscillates, 0 = off (default %(default)s)")

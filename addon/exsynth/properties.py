@@ -28,6 +28,17 @@ _SOLID_METHOD_TEXT = {
 }
 SOLID_METHOD_ITEMS = tuple((m.upper(), *_SOLID_METHOD_TEXT.get(m, (m.title(), m))) for m in _native.SOLID_METHODS)
 
+# The engine's rotate_exemplar choices (_native.ROTATE_EXEMPLAR_CHOICES), likewise.
+_ROTATE_EXEMPLAR_TEXT = {
+    "auto": ("Auto", "Turn the exemplar when its features are round (the engine measures their stretch); "
+             "wood grain, bricks and bedded stone keep their direction"),
+    "on": ("On", "Always turn it: slower (the exemplar is analysed in four turns, about 1.4x the time at 128 "
+           "voxels); wrong for anything that runs one way"),
+    "off": ("Off", "Never turn it"),
+}
+ROTATE_EXEMPLAR_ITEMS = tuple((c.upper(), *_ROTATE_EXEMPLAR_TEXT.get(c, (c.title(), c)))
+                              for c in _native.ROTATE_EXEMPLAR_CHOICES)
+
 # The direction-field presets (Direction Field and Geometric Texture).
 FIELD_PRESET_ITEMS = (
     ('AROUND_AXIS', "Around Axis", "Circles around the axis through the mesh's centre"),
@@ -139,19 +150,19 @@ class ExSynthSettings(bpy.types.PropertyGroup):
         name="Feature Threshold",
         description="Which dark pixels of the exemplar count as features for Feature Weight, in the "
         "exemplar's brightness standard deviations below their neighbourhood: 0 = any darker pixel "
-        "(soft, isotropic cells); about 1 = only deep cracks and mortar (a crisper crack network, but "
-        "cells and stones may come out stretched along one diagonal). The Coordinates method ignores it",
+        "(soft, isotropic cells); about 1 = only deep cracks and mortar (a crisper crack network; with "
+        "round cells, keep Rotate Exemplar on Auto or On, or they line up along one diagonal). The "
+        "Coordinates method ignores it",
         default=_native.SOLID_DEFAULT_FEATURE_THRESHOLD, min=0.0, max=_native.SOLID_MAX_FEATURE_THRESHOLD,
         soft_max=2.0,
     )
-    solid_rotate_exemplar: BoolProperty(
+    solid_rotate_exemplar: EnumProperty(
         name="Rotate Exemplar",
-        description="Also match the exemplar turned by 90, 180 and 270 degrees: for textures with no preferred "
-        "direction (cracks, stones, granite), whose cells and stones otherwise line up along one diagonal, most "
-        "with a Feature Threshold near 1. Not for wood grain, bricks or anything that runs one way. Slower: the "
-        "exemplar is analysed in four turns (about 1.4x the time at 128 voxels, 3x at 64). The Coordinates method "
-        "ignores it",
-        default=_native.SOLID_DEFAULT_ROTATE_EXEMPLAR,
+        description="Also match the exemplar turned by 90, 180 and 270 degrees, for textures with no preferred "
+        "direction (cracks, cells, pebbles), whose cells otherwise line up along one diagonal. The Coordinates "
+        "method ignores it",
+        items=ROTATE_EXEMPLAR_ITEMS,
+        default=_native.SOLID_DEFAULT_ROTATE_EXEMPLAR.upper(),
     )
     solid_histogram_values: FloatProperty(
         name="Histogram Values",

@@ -20,6 +20,12 @@ SolidSearch to_search(const std::string& s) {
   throw InvalidInput("search must be 'kcoherence', 'kdtree' or 'exact', got '" + s + "'");
 }
 
+// rotate_exemplar: 'off', 'on', 'auto', or a bool (on / off).
+RotateExemplar rotate_arg(const py::handle& v, const std::string& k) {
+  if (py::isinstance<py::bool_>(v)) return bool_arg(v, k) ? RotateExemplar::On : RotateExemplar::Off;
+  return rotate_exemplar_from_name(string_arg(v, k, "'off', 'on' or 'auto' (or True / False)"));
+}
+
 // The optimiser's options, which both entry points share.
 constexpr const char* kCommonNames =
     "levels, neighborhood, iterations, finest_iterations, r, pca_variance, max_pca_dims, search, coherence_k, "
@@ -56,7 +62,7 @@ void set_common(TextureOptimizationOptions& o, const py::kwargs& kw, const std::
     else if (k == "feature_weight") o.feature_weight = real_arg(v, k, 0.0, 100.0, Ends::Closed, "0 = off");
     else if (k == "feature_threshold")
       o.feature_threshold = real_arg(v, k, 0.0, kMaxFeatureThreshold, Ends::Closed, "0 = darker than the window's mean at all");
-    else if (k == "rotate_exemplar") o.rotate_exemplar = bool_arg(v, k);
+    else if (k == "rotate_exemplar") o.rotate_exemplar = rotate_arg(v, k);
     else if (k == "tileable") o.tileable = bool_arg(v, k);
     else if (k == "max_exemplar_size") o.max_exemplar_size = int_arg(v, k, 0, 1 << 16);
     else if (k == "memory_budget") o.memory_budget = memory_budget_arg(v, k);
@@ -184,7 +190,22 @@ void bind_solid(py::module_& m) {
   m.attr("SOLID_DEFAULT_HISTOGRAM_VALUES") = SolidOptions{}.histogram_values;
   m.attr("SOLID_DEFAULT_FEATURE_THRESHOLD") = SolidOptions{}.feature_threshold;
   m.attr("SOLID_MAX_FEATURE_THRESHOLD") = kMaxFeatureThreshold;
-  m.attr("SOLID_DEFAULT_ROTATE_EXEMPLAR") = SolidOptions{}.rotate_exemplar;
+  m.attr("SOLID_DEFAULT_ROTATE_EXEMPLAR") = rotate_exemplar_name(SolidOptions{}.rotate_exemplar);
+  m.attr("ROTATE_EXEMPLAR_CHOICES") = py::make_tuple(rotate_exemplar_name(RotateExemplar::Off),
+                                                     rotate_exemplar_name(RotateExemplar::On),
+                                                     rotate_exemplar_name(RotateExemplar::Auto));
+  m.attr("ROUND_FEATURE_STRETCH") = kRoundFeatureStretch;
+  m.def(
+      "exemplar_feature_stretch",
+      [](const ArrayArg& exemplar, const py::kwargs& extra) {
+        reject_unknown(extra, "none besides the exemplar");
+        const Image img = to_image(exemplar, "exemplar");
+        py::gil_scoped_release release;
+        return exemplar_feature_stretch(img);
+      },
+      py::arg("exemplar"),
+      "The exemplar's feature stretch (1 = round features), which rotate_exemplar='auto' compares with "
+      "ROUND_FEATURE_STRETCH: the exemplar is used in its quarter turns below it.");
   m.attr("SOLID_MAX_SIZE") = kMaxSolidSize;
   m.attr("IMAGE_MAX_SIZE") = kMaxImageSize;
   m.attr("DEFAULT_MAX_EXEMPLAR_SIZE") = kDefaultMaxExemplarSize;
@@ -222,6 +243,7 @@ void bind_solid(py::module_& m) {
         py::dict out;
         out["energy"] = to_list(r.energy);
         out["energy_level"] = py::cast(r.energy_level);
+        out["rotated_exemplar"] = py::make_tuple(r.rotated_exemplar[0], r.rotated_exemplar[1], r.rotated_exemplar[2]);
         Volume& t = r.texture;
         const py::ssize_t c = t.channels();
         out["solid"] = take_vector(std::move(t.values()), {t.nz(), t.ny(), t.nx(), c});
@@ -243,16 +265,18 @@ mean_shift=False, coherent_upsampling=True, exemplar_values=True, histogram_valu
 exemplar values match the exemplars' histogram, this being the step of the per-bin prices; 0 = off), histogram_value_rounds=32
 (its pricing rounds), histogram_value_window=0 (0..1: the share of a proposal's price taken from its whole
 window's texels, for coherent choices), feature_weight=SOLID_DEFAULT_FEATURE_WEIGHT (the feature-distance channel's weight; 0 = off),
-feature_threshold=0 (features: pixels darker than their window's mean by more than this x the exemplar's
-luminance std), rotate_exemplar=False (also the exemplar's 90/180/270-degree turns, for textures
-with no preferred direction: cracks, stones), tileable=True,
+feature_threshold=SOLID_DEFAULT_FEATURE_THRESHOLD (features: pixels darker than their window's mean by more than this x the
+exemplar's luminance std), rotate_exemplar=SOLID_DEFAULT_ROTATE_EXEMPLAR ('on': also the exemplar's 90/180/270-degree
+turns, for textures with no preferred direction: cracks, cells; 'auto': when exemplar_feature_stretch(exemplar) <
+ROUND_FEATURE_STRETCH; 'off'; True / False = 'on' / 'off'), tileable=True,
 max_exemplar_size=256 (working resolution: larger exemplars are halved until they fit; 0 = never),
 method=SOLID_DEFAULT_METHOD ('optimization': Kopf et al. 2007; 'coordinates': exemplar coordinates after
 Dong et al. 2008, which uses levels, iterations, finest_iterations, coordinate_coherence_k=0 (0..16), pca_variance, max_pca_dims,
 max_exemplar_size, tileable, memory_budget and seed (feature_weight, feature_threshold, rotate_exemplar and histogram_values
 do not apply), and takes no constraint),
 memory_budget=0 (default), seed=0. size: min_texture_size(levels, neighborhood) .. SOLID_MAX_SIZE.
-Returns {'solid': (Z, Y, X, C) float32, 'energy': [...], 'energy_level': [...]}.)doc");
+Returns {'solid': (Z, Y, X, C) float32, 'energy': [...], 'energy_level': [...], 'rotated_exemplar': (x, y, z)
+(per view, whether its exemplar was used in its quarter turns)}.)doc");
 
   m.def(
       "synthesize_image",

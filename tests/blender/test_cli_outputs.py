@@ -185,15 +185,17 @@ def refuses(tmp_path, capsys, args, message, code=None):
 
 
 def test_solid_feature_threshold(tmp_path, capsys):
-    solid_as_the_engine_makes(tmp_path, capsys, ["--feature-threshold", "1"], "feature_threshold", 1.0, 0.0)
+    solid_as_the_engine_makes(tmp_path, capsys, ["--feature-threshold", "0"], "feature_threshold", 0.0, 1.0)
     for value in ("-1", "11"):
         refuses(tmp_path, capsys, ["--feature-threshold", value],
                 f"--feature-threshold must be in 0..10 (got {float(value)})")
 
 
 def test_solid_rotate_exemplar(tmp_path, capsys):
-    solid_as_the_engine_makes(tmp_path, capsys, ["--rotate-exemplar"], "rotate_exemplar", True, False)
-    refuses(tmp_path, capsys, ["--rotate-exemplar", "yes"], "unrecognized arguments: yes", code=2)
+    # The flag alone turns the exemplar; auto (the default) and off by name.
+    solid_as_the_engine_makes(tmp_path, capsys, ["--rotate-exemplar"], "rotate_exemplar", "on", "off")
+    solid_as_the_engine_makes(tmp_path, capsys, ["--rotate-exemplar", "off"], "rotate_exemplar", "off", "on")
+    refuses(tmp_path, capsys, ["--rotate-exemplar", "yes"], "invalid choice: 'yes'", code=2)
 
 
 def test_solid_histogram_values(tmp_path, capsys):

@@ -690,11 +690,18 @@ def test_feature_threshold_defaults_to_the_engines_and_reaches_it(cow, exemplar)
     assert settings().solid_feature_threshold == pytest.approx(_native.SOLID_DEFAULT_FEATURE_THRESHOLD)
     rna = settings().bl_rna.properties["solid_feature_threshold"]
     assert (rna.hard_min, rna.hard_max) == (0.0, pytest.approx(_native.SOLID_MAX_FEATURE_THRESHOLD))
-    settings().solid_feature_threshold = 1.0
-    made_as_the_engine_makes(exemplar, "feature_threshold", 1.0, 0.0)
+    settings().solid_feature_threshold = 0.0
+    made_as_the_engine_makes(exemplar, "feature_threshold", 0.0, 1.0)
 
 
 def test_rotate_exemplar_defaults_to_the_engines_and_reaches_it(cow, exemplar):
-    assert settings().solid_rotate_exemplar is _native.SOLID_DEFAULT_ROTATE_EXEMPLAR is False
-    settings().solid_rotate_exemplar = True
-    made_as_the_engine_makes(exemplar, "rotate_exemplar", True, False)
+    assert settings().solid_rotate_exemplar == _native.SOLID_DEFAULT_ROTATE_EXEMPLAR.upper() == "AUTO"
+    items = settings().bl_rna.properties["solid_rotate_exemplar"].enum_items
+    assert tuple(i.identifier.lower() for i in items) == _native.ROTATE_EXEMPLAR_CHOICES
+    # crackedground's features are round: auto turns it, as on does; off differs.
+    made_as_the_engine_makes(exemplar, "rotate_exemplar", "on", "off")
+
+
+def test_rotate_exemplar_off_reaches_the_engine(cow, exemplar):
+    settings().solid_rotate_exemplar = 'OFF'
+    made_as_the_engine_makes(exemplar, "rotate_exemplar", "off", "on")

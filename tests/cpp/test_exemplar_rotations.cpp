@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <array>
+#include <cmath>
 #include <cstdint>
 #include <string>
 
@@ -45,7 +46,7 @@ SolidOptions small_rotated_options() {
   o.levels = 2;
   o.iterations = 2;
   o.seed = 9;
-  o.rotate_exemplar = true;
+  o.rotate_exemplar = RotateExemplar::On;
   return o;
 }
 
@@ -107,7 +108,7 @@ TEST(ExemplarRotations, SolidTakesTexelsFromEveryTurn) {
   }
   for (int q = 0; q < 4; ++q) EXPECT_GT(per_turn[q], int(r.texture.voxel_count() / 20)) << "turn " << q;
   SolidOptions plain = small_rotated_options();
-  plain.rotate_exemplar = false;
+  plain.rotate_exemplar = RotateExemplar::Off;
   EXPECT_NE(synthesize_solid(one_exemplar(ex), plain).texture.values(), r.texture.values());
 }
 
@@ -117,4 +118,57 @@ TEST(ExemplarRotations, SameSolidOnAnyThreadCount) {
   const std::vector<float> one = on_threads(1, run);
   EXPECT_EQ(on_threads(3, run), one);
   EXPECT_EQ(on_threads(8, run), one);
+}
+
+// rotate_exemplar = Auto decides on exemplar_feature_stretch (exsynth.quality's
+// lobe_stretch, which the Python tier compares it with): round features near
+// 1, a blob stretched 3:1 well above kRoundFeatureStretch, the same stretch
+// whatever the turn, and a flat exemplar counted as round.
+namespace {
+
+Image blobs(int s, double sx, double sy) {  // Gaussian blobs on a lattice, sx x sy pixels
+  Image img(s, s, 1);
+  for (int y = 0; y < s; ++y)
+    for (int x = 0; x < s; ++x) {
+      double v = 0.0;
+      for (int cy = 8; cy < s; cy += 16)
+        for (int cx = 8 + (cy / 16 % 2) * 8; cx < s + 8; cx += 16) {
+          const double dx = (x - cx) / sx, dy = (y - cy) / sy;
+          v += std::exp(-0.5 * (dx * dx + dy * dy));
+        }
+      img.at(x, y, 0) = float(v);
+    }
+  return img;
+}
+
+}  // namespace
+
+TEST(ExemplarRotations, FeatureStretchTellsRoundFromStretchedFeatures) {
+  const double round = exemplar_feature_stretch(blobs(64, 2.0, 2.0));
+  const Image long_blobs = blobs(64, 4.5, 1.5);
+  const double stretched = exemplar_feature_stretch(long_blobs);
+  EXPECT_LT(round, 1.1);
+  EXPECT_GT(stretched, 2.0);
+  EXPECT_LT(round, kRoundFeatureStretch);
+  EXPECT_GT(stretched, kRoundFeatureStretch);
+  const Image turned_blobs = solid::quarter_turn_mosaic(long_blobs);  // its top right quarter: a quarter turn
+  EXPECT_NEAR(exemplar_feature_stretch(crop(turned_blobs, 64, 0, 64)), stretched, 1e-9);
+  EXPECT_EQ(exemplar_feature_stretch(Image(16, 16, 3)), 1.0);  // flat: no direction
+}
+
+TEST(ExemplarRotations, AutoTurnsRoundExemplarsOnly) {
+  SolidExemplars ex;
+  const Image round = blobs(48, 2.0, 2.0), stretched = blobs(48, 4.5, 1.5);
+  ex.views = {round, stretched, stretched};
+  SolidOptions o = small_rotated_options();
+  o.rotate_exemplar = RotateExemplar::Auto;
+  const TextureResult auto_result = synthesize_solid(ex, o);
+  EXPECT_EQ(auto_result.rotated_exemplar, (std::array<bool, 3>{true, false, false}));
+  o.rotate_exemplar = RotateExemplar::On;
+  EXPECT_EQ(synthesize_solid(ex, o).rotated_exemplar, (std::array<bool, 3>{true, true, true}));
+  o.rotate_exemplar = RotateExemplar::Off;
+  EXPECT_EQ(synthesize_solid(ex, o).rotated_exemplar, (std::array<bool, 3>{false, false, false}));
+  EXPECT_EQ(rotate_exemplar_from_name("auto"), RotateExemplar::Auto);
+  EXPECT_STREQ(rotate_exemplar_name(RotateExemplar::On), "on");
+  EXPECT_THROW(rotate_exemplar_from_name("yes"), InvalidInput);
 }

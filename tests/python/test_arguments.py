@@ -69,7 +69,7 @@ FUNCTIONS = {
         "random_candidates": ("int", 0, 64), "ann_eps": ("real", 0, 1e6), "histogram_matching": "bool",
         "histogram_bins": ("int", 2, 256), "histogram_strength": ("real", 0, 16), "mean_shift": "bool",
         "feature_weight": ("real", 0, 100),
-        "feature_threshold": ("real", 0, 10), "rotate_exemplar": "bool",
+        "feature_threshold": ("real", 0, 10), "rotate_exemplar": "str",
         "exemplar_values": "bool", "histogram_values": ("real", 0, 100), "histogram_value_rounds": ("int", 1, 64),
         "histogram_value_window": ("real", 0, 1),
         "tileable": "bool", "memory_budget": "budget", "seed": "seed", "ctx": "ctx",
@@ -96,6 +96,7 @@ FUNCTIONS = {
         "preset": "str", "resolution": ("int", 8, 512), "thickness": ("real", 0, None),
         "spacing": ("real", 0, None), "jitter": ("real", 0, 0.25), "dilation": ("real", 0, None),
         "groove_direction": "str", "memory_budget": "budget"}),
+    "exemplar_feature_stretch": (call("exemplar_feature_stretch", IMG), {}),
     "min_texture_size": (call("min_texture_size"), {"levels": ("int", 1, 8), "neighborhood": ("int", 3, 32)}),
     "voxel_grid": (call("voxel_grid", (0, 0, 0), (1, 2, 3)), {
         "resolution": ("int", 1, 2 ** 14), "voxel_size": ("real", 0, None), "padding": ("int", 0, 1024)}),

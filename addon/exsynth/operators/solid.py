@@ -150,7 +150,7 @@ class SolidJob(Job):
     method: str = None              # one of _native.SOLID_METHODS; None = the engine's default
     feature_weight: float = _native.SOLID_DEFAULT_FEATURE_WEIGHT  # the optimiser's; 0 = off
     feature_threshold: float = _native.SOLID_DEFAULT_FEATURE_THRESHOLD  # which dark pixels are features
-    rotate_exemplar: bool = _native.SOLID_DEFAULT_ROTATE_EXEMPLAR  # also its quarter turns
+    rotate_exemplar: str = _native.SOLID_DEFAULT_ROTATE_EXEMPLAR  # its quarter turns: off, on, auto
     histogram_values: float = _native.SOLID_DEFAULT_HISTOGRAM_VALUES  # the optimiser's; 0 = off
     scale: float = 1.0              # edge length of one tile
     seed: int = 0
@@ -358,7 +358,7 @@ class EXSYNTH_OT_solid_texture(JobOperator, bpy.types.Operator):
             exemplar_y=exemplar_y, exemplar_z=exemplar_z, size=settings.solid_size,
             levels=settings.solid_levels, iterations=settings.solid_iterations,
             method=settings.solid_method.lower(), feature_weight=settings.solid_feature_weight,
-            feature_threshold=settings.solid_feature_threshold, rotate_exemplar=settings.solid_rotate_exemplar,
+            feature_threshold=settings.solid_feature_threshold, rotate_exemplar=settings.solid_rotate_exemplar.lower(),
             histogram_values=settings.solid_histogram_values,
             scale=settings.solid_scale, seed=settings.seed,
             memory_budget=settings.memory_budget_bytes, encoding=encoding, anchor=anchor,

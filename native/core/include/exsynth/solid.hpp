@@ -68,6 +68,46 @@ constexpr double kSolidFeatureWeight = 3.0;
 /// overshoots halves it.
 constexpr double kSolidHistogramValues = 0.3;
 
+/// Solids' feature_threshold (SolidOptions): the feature channel marks the
+/// pixels darker than their window's mean by more than one luminance
+/// standard deviation (the cracks and mortar themselves, not half of every
+/// window). With kSolidRotateExemplar: 23 of 24 sharpness / contrast /
+/// hist_emd slice targets of 8 exemplars at 64^3, against 18 at 0, and 28
+/// of 33 against 24 on 11 held-out gimp-data patterns (docs/solid.md,
+/// fifteenth pass). Alone it lines up round-featured exemplars' cells as
+/// parallel sheets (crackedground: 3D elongation 2.5), hence the turns.
+constexpr double kSolidFeatureThreshold = 1.0;
+
+/// When TextureOptimizationOptions::rotate_exemplar uses the exemplar's
+/// quarter turns.
+enum class RotateExemplar {
+  Off,
+  On,
+  /// On when the exemplar's features are round (exemplar_feature_stretch
+  /// below kRoundFeatureStretch): cracks, cells, pebbles, paper; off for
+  /// what runs one way (wood, bricks, bedded stone), whose turns would put
+  /// mortar and grain the wrong way.
+  Auto,
+};
+const char* rotate_exemplar_name(RotateExemplar r);
+/// "off", "on" or "auto"; InvalidInput naming them otherwise.
+RotateExemplar rotate_exemplar_from_name(const std::string& name);
+
+/// The exemplar's feature stretch: sqrt(largest / smallest eigenvalue) of
+/// the second moments of its luminance autocorrelation's central lobe (the
+/// lags connected to 0 where the autocorrelation, after a Gaussian blur of
+/// one pixel, exceeds 0.3); 1 = round features. exsynth.quality.lobe_stretch
+/// is the same measure.
+double exemplar_feature_stretch(const Image& exemplar);
+/// RotateExemplar::Auto turns exemplars whose stretch is below this. Of 30
+/// gimp-data and bundled exemplars at 128^2, those below are crackedground
+/// 1.04, java 1.07, amethyst 1.15, marble2 1.18, paper 1.24, terra 1.28;
+/// the nearest above are walnut 1.37, parque3 1.41 and wood5 1.45, which
+/// run one way (docs/solid.md, fifteenth pass).
+constexpr double kRoundFeatureStretch = 1.3;
+/// Solids' rotate_exemplar (SolidOptions).
+constexpr RotateExemplar kSolidRotateExemplar = RotateExemplar::Auto;
+
 /// Bins per value channel of TextureOptimizationOptions::histogram_values
 /// (the quality measure's hist_emd uses 32 over the 8-bit range).
 constexpr int kValueBins = 32;
@@ -145,12 +185,14 @@ struct TextureOptimizationOptions {
   /// crackedground's cells come out as parallel sheets: docs/solid.md,
   /// thirteenth and fourteenth passes). Up to kMaxFeatureThreshold.
   double feature_threshold = 0.0;
-  /// The exemplar is used in its four quarter turns (its central square,
-  /// as one mosaic): for textures with no preferred direction (cracks,
-  /// stones, granite), whose cells otherwise line up as parallel sheets,
-  /// most at feature_threshold 1; not for wood, bricks or anything that runs
-  /// one way. Costs 4x the exemplar analysis (docs/solid.md, fourteenth pass).
-  bool rotate_exemplar = false;
+  /// On: the exemplar is used in its four quarter turns (its central
+  /// square, as one mosaic): for textures with no preferred direction
+  /// (cracks, cells, pebbles), whose cells otherwise line up as parallel
+  /// sheets, most at feature_threshold 1; not for wood, bricks or anything
+  /// that runs one way. Auto decides per exemplar (RotateExemplar). Costs
+  /// 4x the exemplar analysis (docs/solid.md, fourteenth and fifteenth
+  /// passes). Images' default Off; solids default to kSolidRotateExemplar.
+  RotateExemplar rotate_exemplar = RotateExemplar::Off;
   bool tileable = true;          ///< toroidal boundaries, so the output tiles
   /// Working resolution: an exemplar whose longer edge exceeds this many
   /// pixels is analysed at half, quarter, ... resolution (Gaussian pyramid
@@ -217,6 +259,8 @@ struct SolidOptions : TextureOptimizationOptions {
     finest_iterations = -1;
     feature_weight = kSolidFeatureWeight;        // method Coordinates ignores both
     histogram_values = kSolidHistogramValues;
+    feature_threshold = kSolidFeatureThreshold;
+    rotate_exemplar = kSolidRotateExemplar;
   }
 };
 /// The default method's name (SolidOptions{}.method).
@@ -230,6 +274,8 @@ struct TextureResult {
   /// view * 2^28 + pixel index (row * width + column) in that view's working
   /// exemplar; -1 where the optimised value was kept. Empty otherwise.
   std::vector<std::int32_t> source;
+  /// Per view, whether its exemplar was used in its quarter turns (rotate_exemplar).
+  std::array<bool, 3> rotated_exemplar{};
 };
 
 TextureResult synthesize_solid(const SolidExemplars& exemplars, const SolidOptions& opt = {},

@@ -135,6 +135,7 @@ struct PreparedExemplars {
   int exponent = 0;                         // values were scaled by 2^-exponent
   const Volume* constraint = nullptr;       // the job's, scaled like the exemplars
   std::vector<Image> working, scaled, featured, rotated;
+  std::vector<bool> turned;                 // per image: used in its quarter turns (rotate_exemplar)
   Volume scaled_constraint;
 
   PreparedExemplars() = default;
@@ -198,6 +199,12 @@ void prepare_exemplars(const Job& job, const TextureOptimizationOptions& opt, Pr
       p.constraint = &p.scaled_constraint;
     }
   }
+  // Which exemplars take their quarter turns: decided on the exemplar's own
+  // channels, before the feature channel joins them.
+  p.turned.assign(p.images.size(), opt.rotate_exemplar == RotateExemplar::On);
+  if (opt.rotate_exemplar == RotateExemplar::Auto)
+    for (std::size_t e = 0; e < p.images.size(); ++e)
+      p.turned[e] = exemplar_feature_stretch(*p.images[e]) < kRoundFeatureStretch;
   // The feature-distance channel, appended after the exemplar's channels: the
   // constraint's targets (the exemplar's channels) leave it free.
   if (opt.feature_weight > 0) {
@@ -209,13 +216,12 @@ void prepare_exemplars(const Job& job, const TextureOptimizationOptions& opt, Pr
   }
   // Last, so the feature channel is the one of the whole exemplar, turned
   // with it (its square window and Euclidean distances turn exactly).
-  if (opt.rotate_exemplar) {
-    p.rotated.reserve(p.images.size());
-    for (const Image*& img : p.images) {
-      p.rotated.push_back(solid::quarter_turn_mosaic(*img));
-      img = &p.rotated.back();
+  p.rotated.reserve(p.images.size());
+  for (std::size_t e = 0; e < p.images.size(); ++e)
+    if (p.turned[e]) {
+      p.rotated.push_back(solid::quarter_turn_mosaic(*p.images[e]));
+      p.images[e] = &p.rotated.back();
     }
-  }
 }
 
 void check_constraint(const Job& job, int channels) {
@@ -253,16 +259,17 @@ void check_texture_memory(const Job& job, const TextureOptimizationOptions& opt,
   }
   const std::string size = job.name == "image" ? std::to_string(job.finest.d[0]) + "x" + std::to_string(job.finest.d[1])
                                                : std::to_string(job.finest.d[0]) + "^3";
+  const bool mosaic = std::any_of(p.rotated.begin(), p.rotated.end(), [&](const Image& r) { return &r == largest; });
   const std::string exemplar = std::to_string(largest->width()) + "x" + std::to_string(largest->height()) + " " +
                                std::to_string(p.user_channels) + "-channel exemplar" +  // as the caller gave it
-                               (opt.rotate_exemplar ? " mosaic (its four quarter turns, rotate_exemplar)" : "");
+                               (mosaic ? " mosaic (its four quarter turns, rotate_exemplar)" : "");
   if (exemplar_bytes >= texture_bytes)
     check_memory_budget(texture_bytes + exemplar_bytes, opt.memory_budget,
                         "analysing the " + exemplar + " (" + std::to_string(n) + "x" + std::to_string(n) +
                             " neighbourhoods) for a " + size + " " + job.name,
                         std::string("the exemplar is too big: give a smaller exemplar or a lower max_exemplar_size "
                                     "(working resolution), fewer channels or a smaller neighbourhood") +
-                            (opt.rotate_exemplar ? ", turn rotate_exemplar off" : "") + ", or raise the memory budget");
+                            (mosaic ? ", set rotate_exemplar to off" : "") + ", or raise the memory budget");
   else
     check_memory_budget(texture_bytes + exemplar_bytes, opt.memory_budget, "synthesizing a " + size + " " + job.name,
                         "lower the size or raise the memory budget");
@@ -361,12 +368,16 @@ TextureResult optimize_texture(const Job& job, const TextureOptimizationOptions&
   PyramidOptions popt;
   popt.levels = L;
   std::vector<std::vector<Image>> pyramids;
-  for (const Image* img : ex.images) {
+  for (std::size_t e = 0; e < ex.images.size(); ++e) {
+    const Image* img = ex.images[e];
     pyramids.push_back(gaussian_pyramid(*img, popt));
+    // A turned exemplar's windows must fit in one turn: a quarter of the mosaic.
+    const int q = ex.turned[e] ? 2 : 1;
     const Image& coarsest = pyramids.back().back();
-    if (coarsest.width() < n || coarsest.height() < n)
-      throw InvalidInput("an exemplar of " + std::to_string(img->width()) + "x" + std::to_string(img->height()) +
-                         " pixels is " + std::to_string(coarsest.width()) + "x" + std::to_string(coarsest.height()) +
+    if (coarsest.width() / q < n || coarsest.height() / q < n)
+      throw InvalidInput("an exemplar of " + std::to_string(img->width() / q) + "x" + std::to_string(img->height() / q) +
+                         " pixels" + (q > 1 ? std::string(" (its central square, turned for rotate_exemplar)") : "") +
+                         " is " + std::to_string(coarsest.width() / q) + "x" + std::to_string(coarsest.height() / q) +
                          " at the coarsest of " + std::to_string(L) + " levels, smaller than the " + std::to_string(n) + "x" +
                          std::to_string(n) + " neighbourhood; use a larger exemplar, fewer levels or a smaller neighbourhood");
   }
@@ -435,6 +446,7 @@ TextureResult optimize_texture(const Job& job, const TextureOptimizationOptions&
   if (ex.exponent != 0)
     for (float& v : tex.values()) v = std::ldexp(v, ex.exponent);
   result.texture = std::move(tex);
+  for (int i = 0; i < 3; ++i) result.rotated_exemplar[i] = ex.image_of[i] >= 0 && ex.turned[std::size_t(ex.image_of[i])];
   return result;
 }
 
