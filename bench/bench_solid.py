@@ -8,7 +8,7 @@ so speed and quality are read together. The coordinates rows' energy is
 another unit (the last correction pass's mean crossbar cost in appearance
 space); "cpu s" is the whole process's user+sys.
 
-usage: bench_solid.py --build BUILD_DIR [--cases solid128,solid128_threshold,solid128_rotated,solid128_brick,solid256,image256,coord64,coord128]
+usage: bench_solid.py --build BUILD_DIR [--cases solid128,solid128_unturned,solid128_t0,solid128_brick,solid256,image256,coord64,coord128]
 """
 import argparse
 import json
@@ -27,22 +27,21 @@ CASES = {
     "solid128_brick": ("solid 128^3 RGB, brick (priced)",
                        "sys.path.insert(0, BENCH); from bench_quality import exemplar; ex = exemplar('brick'); "
                        "res = _native.synthesize_solid(ex, size=128, levels=3, seed=1)"),
-    # feature_threshold = 1 (an option, docs/solid.md thirteenth and fourteenth passes): one more pass
-    # over the exemplar, then other matches
-    "solid128_threshold": ("solid 128^3 RGB, threshold 1",
-                           "res = _native.synthesize_solid(ex, size=128, levels=3, seed=1, feature_threshold=1.0)"),
-    # rotate_exemplar (with threshold 1, as docs/solid.md's fourteenth pass suggests): the exemplar's
-    # analysis runs on its four quarter turns, 4x the windows
-    "solid128_rotated": ("solid 128^3 RGB, rotated, thr. 1",
-                         "res = _native.synthesize_solid(ex, size=128, levels=3, seed=1, feature_threshold=1.0, "
-                         "rotate_exemplar=True)"),
+    # the defaults before the fifteenth pass (docs/solid.md): feature threshold 0, the exemplar as given
+    "solid128_t0": ("solid 128^3 RGB, threshold 0, unturned",
+                    "res = _native.synthesize_solid(ex, size=128, levels=3, seed=1, feature_threshold=0.0, "
+                    "rotate_exemplar='off')"),
+    # crackedground's features are round, so the default turns it (rotate_exemplar='auto'); the
+    # analysis runs on its four quarter turns, 4x the windows. Unturned, for the cost of the turns:
+    "solid128_unturned": ("solid 128^3 RGB, unturned",
+                          "res = _native.synthesize_solid(ex, size=128, levels=3, seed=1, rotate_exemplar='off')"),
     "solid256": ("solid 256^3 RGB, 3 levels", "res = _native.synthesize_solid(ex, size=256, levels=3, seed=1)"),
     "image256": ("image 128^2 -> 256^2, 3 levels", "res = _native.synthesize_image(ex, width=256, height=256, seed=1)"),
     # method="coordinates" (exemplar coordinates; the solid rows above use the default method)
     "coord64": ("solid 64^3 RGB, coordinates", "res = _native.synthesize_solid(ex, size=64, seed=1, method='coordinates')"),
     "coord128": ("solid 128^3 RGB, coordinates", "res = _native.synthesize_solid(ex, size=128, seed=1, method='coordinates')"),
 }
-DEFAULT_CASES = "solid128,solid128_threshold,solid128_rotated,solid128_brick,solid256,image256"
+DEFAULT_CASES = "solid128,solid128_unturned,solid128_t0,solid128_brick,solid256,image256"
 
 
 CHILD = """
