@@ -180,8 +180,8 @@ def _parser():
                    "(cracks, mortar) in the matching; higher = crisper, 0 = colours only (default %(default)s)")
     p.add_argument("--feature-threshold", type=_finite, default=_native.SOLID_DEFAULT_FEATURE_THRESHOLD,
                    help="with --method optimization: which exemplar pixels are features, in luminance standard "
-                   "deviations below their window's mean; 0 = any darker pixel, ~1 = only deep cracks and mortar "
-                   "(crisper cracks, but cells may stretch along a diagonal) (default %(default)s)")
+                   "deviations below their window's mean; 0 = any darker pixel (softer cells), 1 = only deep cracks and "
+                   "mortar (crisper; round cells need --rotate-exemplar auto or on) (default %(default)s)")
     p.add_argument("--rotate-exemplar", choices=_native.ROTATE_EXEMPLAR_CHOICES, nargs="?",
                    const="on", default=_native.SOLID_DEFAULT_ROTATE_EXEMPLAR,
                    help="with --method optimization: also match the exemplar turned by 90, 180 and 270 degrees, "

@@ -72,6 +72,13 @@ TEST(ExhaustiveNearest, MatchesTheRowByRowReference) {
   expect_same_as_reference(400, 8, 0.0f, 97, 3);
 }
 
+TEST(ExhaustiveNearest, ManyDimensionsKeepTheExactAnswer) {
+  // max_pca_dims goes up to 4096, and the rounding bound grows with the
+  // dimension (this case passes with the fixed 1e-4 too: real errors sit far
+  // below the worst case; it checks the wide path, not the bound).
+  expect_same_as_reference(300, 1024, 3.0f, 64, 7);
+}
+
 TEST(ExhaustiveNearest, LargeOffsetsKeepTheExactAnswer) {
   // |q|^2 and |c|^2 ~ 1e4 x the distances: the GEMM's |c|^2 - 2 q.c loses
   // digits that the re-ranking restores.

@@ -99,7 +99,7 @@ RotateExemplar rotate_exemplar_from_name(const std::string& name);
 /// one pixel, exceeds 0.3); 1 = round features. exsynth.quality.lobe_stretch
 /// is the same measure.
 double exemplar_feature_stretch(const Image& exemplar);
-/// RotateExemplar::Auto turns exemplars whose stretch is below this. Of 30
+/// RotateExemplar::Auto turns exemplars whose stretch is below this. Of 33
 /// gimp-data and bundled exemplars at 128^2, those below are crackedground
 /// 1.04, java 1.07, amethyst 1.15, marble2 1.18, paper 1.24, terra 1.28;
 /// the nearest above are walnut 1.37, parque3 1.41 and wood5 1.45, which

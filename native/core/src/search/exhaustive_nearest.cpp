@@ -18,10 +18,11 @@ int ExhaustiveNearest::brute_force(const RowMatrixXf& rows, const RowMatrixXf& q
 
 // Rounding: a d-term float dot product or squared norm is within about
 // d * 2^-24 * (|q| + |c|)^2 <= d * 2^-23 * (|q|^2 + |c|^2) of its exact value
-// (d <= 64 here: 4e-6 relative), for the GEMM's distances and the
-// re-ranking's alike. A row whose GEMM distance is within twice that of the
-// batch row's GEMM minimum may be the re-ranking's minimum; 1e-4 relative
-// covers it with margin, and in practice leaves one to a few rows to re-rank.
+// (the solver's 32 PCA dimensions: 4e-6 relative), for the GEMM's distances
+// and the re-ranking's alike. A row whose GEMM distance is within twice that
+// of the batch row's GEMM minimum may be the re-ranking's minimum; 1e-4
+// relative covers it with margin up to 400 dimensions (more: 4 d 2^-23), and
+// in practice leaves one to a few rows to re-rank.
 constexpr float kRelativeTolerance = 1e-4f;
 
 void ExhaustiveNearest::nearest(const RowMatrixXf& queries, Eigen::Index count, int* best, RowMatrixXf& scratch) const {
@@ -44,7 +45,8 @@ void ExhaustiveNearest::nearest(const RowMatrixXf& queries, Eigen::Index count, 
       best[k] = brute_force(rows_, queries, k);
       continue;
     }
-    const float bound = lowest + kRelativeTolerance * (q2 + max_norm_);
+    const float relative = std::max(kRelativeTolerance, 4.0f * float(rows_.cols()) * std::numeric_limits<float>::epsilon());
+    const float bound = lowest + relative * (q2 + max_norm_);
     int pick = -1;
     float pick_d = 0.0f;
     for (Eigen::Index j = 0; j < n; ++j) {
