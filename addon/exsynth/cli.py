@@ -558,7 +558,7 @@ def _run_solid(args):
     n, c = solid.size, solid.values.shape[3]
     energy = f", final energy {solid.energy[-1]:.4g}" if solid.energy else ""
     line = (f"solid: {n}x{n}x{n} voxels x {c} channels of {solid.voxel_size:.6g} from "
-            f"{os.path.basename(paths[0])} in {seconds:.2f} s{energy} -> {args.out}")
+            f"{os.path.basename(paths[0])} in {seconds:.2f} s{energy}{solid.turned_note()} -> {args.out}")
     if args.mesh:
         baked = result.baked[0]
         image_io.save_png(bake_out, baked.pixels, encoding)

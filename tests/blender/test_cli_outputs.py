@@ -211,3 +211,13 @@ def test_run_image_keeps_to_the_memory_budget_with_either_method(tmp_path, capsy
                     "--memory-budget", "0.001", "--out", str(out))
     assert code == 1 and "over the memory budget" in err and "nothing was written" in err
     assert os.listdir(tmp_path) == []
+
+
+def test_solid_says_when_the_exemplar_was_turned(tmp_path, capsys):
+    # crackedground's features are round: the default (auto) turns it, and the line says so.
+    out = tmp_path / "o.npy"
+    for flag, said in (([], True), (["--rotate-exemplar", "off"], False)):
+        code = cli.main(["solid", "--exemplar", CRACKED, "--size", "16", "--levels", "2", "--iterations", "1",
+                         *flag, "--out", str(out)])
+        printed = capsys.readouterr().out
+        assert code == 0 and ("exemplar also matched in its quarter turns" in printed) == said, printed

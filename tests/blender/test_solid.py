@@ -700,8 +700,10 @@ def test_rotate_exemplar_defaults_to_the_engines_and_reaches_it(cow, exemplar):
     assert tuple(i.identifier.lower() for i in items) == _native.ROTATE_EXEMPLAR_CHOICES
     # crackedground's features are round: auto turns it, as on does; off differs.
     made_as_the_engine_makes(exemplar, "rotate_exemplar", "on", "off")
+    assert bpy.data.objects["crackedground_solid"].data[solid_ops.METADATA]["turned"].to_list() == [1, 1, 1]
 
 
 def test_rotate_exemplar_off_reaches_the_engine(cow, exemplar):
     settings().solid_rotate_exemplar = 'OFF'
     made_as_the_engine_makes(exemplar, "rotate_exemplar", "off", "on")
+    assert bpy.data.objects["crackedground_solid"].data[solid_ops.METADATA]["turned"].to_list() == [0, 0, 0]

@@ -79,6 +79,14 @@ class Solid:
     values: np.ndarray
     voxel_size: float
     energy: list = dataclasses.field(default_factory=list)
+    turned: tuple = (False, False, False)  # per view (x, y, z): its exemplar used in its quarter turns
+
+    def turned_note(self):
+        """What the report says of the exemplar's quarter turns (rotate_exemplar)."""
+        if not any(self.turned):
+            return ""
+        views = "" if all(self.turned) else " for the " + ", ".join(v for v, t in zip("xyz", self.turned) if t) + " view"
+        return f", exemplar also matched in its quarter turns{views}"
 
     @property
     def size(self):
@@ -171,7 +179,7 @@ class SolidJob(Job):
             feature_weight=self.feature_weight, feature_threshold=self.feature_threshold,
             rotate_exemplar=self.rotate_exemplar, histogram_values=self.histogram_values,
         )
-        solid = Solid(res["solid"], self.scale / self.size, list(res["energy"]))
+        solid = Solid(res["solid"], self.scale / self.size, list(res["energy"]), tuple(res["rotated_exemplar"]))
         baked = bake_targets(solid.values, solid.origin, solid.voxel_size, self.targets, self.bake, ctx,
                              span=(0.9, 1.0))
         return SolidResult(self.name, solid, baked, np.asarray(self.anchor, np.float64), self.encoding)
@@ -320,7 +328,7 @@ def add_solid_volume(context, result, created):
     scale = solid.voxel_size * solid.size
     obj.data[METADATA] = {
         "size": solid.size, "scale": scale, "channels": solid.values.shape[3],
-        "encoding": result.encoding, "exemplar": result.name,
+        "encoding": result.encoding, "exemplar": result.name, "turned": [int(t) for t in solid.turned],
     }
     srgb = result.encoding == image_io.SRGB
     obj.data.materials.append(materials.solid_volume_material(name, srgb, 10.0 / scale, created))
@@ -371,7 +379,7 @@ class EXSYNTH_OT_solid_texture(JobOperator, bpy.types.Operator):
             apply_baked(baked, result.encoding, created)
         set_solid_volume(context.scene.exsynth, volume, created)
         n = result.solid.size
-        return (f"ExSynth: solid '{volume.name}' of {n}×{n}×{n} voxels, "
+        return (f"ExSynth: solid '{volume.name}' of {n}×{n}×{n} voxels{result.solid.turned_note()}, "
                 f"baked onto {mesh_names(result.baked)}")
 
 
