@@ -32,8 +32,9 @@ SOLID_METHOD_ITEMS = tuple((m.upper(), *_SOLID_METHOD_TEXT.get(m, (m.title(), m)
 _ROTATE_EXEMPLAR_TEXT = {
     "auto": ("Auto", "Turn the exemplar when its features are round (the engine measures their stretch); "
              "wood grain, bricks and bedded stone keep their direction"),
-    "on": ("On", "Always turn it: slower (the exemplar is analysed in four turns, about 1.4x the time at 128 "
-           "voxels); wrong for anything that runs one way"),
+    "on": ("On", "Always turn it: slower for exemplars under 256 pixels (analysed in four turns: about 1.4x the "
+           "time at 128 voxels; larger ones turn their quadrants, at no extra cost); wrong for anything that runs "
+           "one way"),
     "off": ("Off", "Never turn it"),
 }
 ROTATE_EXEMPLAR_ITEMS = tuple((c.upper(), *_ROTATE_EXEMPLAR_TEXT.get(c, (c.title(), c)))

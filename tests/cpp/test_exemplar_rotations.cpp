@@ -3,10 +3,12 @@
 // turned with it; the solver's texels coming from every turn.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstdint>
 #include <string>
+#include <utility>
 
 #include "exsynth/solid.hpp"
 #include "solid/exemplar_rotations.hpp"
@@ -70,6 +72,32 @@ TEST(ExemplarRotations, MosaicHoldsTheCentralSquaresFourTurns) {
   ASSERT_EQ(mt.width(), 6);
   for (int y = 0; y < 3; ++y)
     for (int x = 0; x < 3; ++x) EXPECT_EQ(mt.at(x, y, 0), tall.at(x, y + 1, 0));
+}
+
+// Larger squares: quarters of kMaxTurnedTile pixels from the square's
+// corners (overlapping), then its four quadrants, each turned once; the
+// mosaic never outgrows max(256^2, the square).
+TEST(ExemplarRotations, LargeSquaresTurnTheirCornersOrQuadrants) {
+  EXPECT_EQ(solid::quarter_turn_tile(100), 100);
+  EXPECT_EQ(solid::quarter_turn_tile(128), 128);
+  EXPECT_EQ(solid::quarter_turn_tile(200), 128);
+  EXPECT_EQ(solid::quarter_turn_tile(256), 128);
+  EXPECT_EQ(solid::quarter_turn_tile(520), 260);
+  for (const auto& [w, h] : {std::pair{230, 200}, std::pair{300, 261}}) {
+    const Image ex = random_image(w, h, 1, 11);
+    const int s = std::min(w, h), t = solid::quarter_turn_tile(s);
+    const int x0 = (w - s) / 2, y0 = (h - s) / 2;
+    const Image m = solid::quarter_turn_mosaic(ex);
+    ASSERT_EQ(m.width(), 2 * t);
+    ASSERT_EQ(m.height(), 2 * t);
+    for (int q = 0; q < 4; ++q) {
+      const Image corner = crop(ex, x0 + (q & 1) * (s - t), y0 + (q >> 1) * (s - t), t);
+      int wrong = 0;
+      for (int y = 0; y < t; ++y)
+        for (int x = 0; x < t; ++x) wrong += m.at((q & 1) * t + x, (q >> 1) * t + y, 0) != turned(corner, q, x, y, 0);
+      EXPECT_EQ(wrong, 0) << w << "x" << h << ", turn " << q;
+    }
+  }
 }
 
 // The solver turns the exemplar after adding its feature channel; that is

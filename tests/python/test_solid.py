@@ -308,8 +308,9 @@ def test_large_exemplar_is_analysed_at_the_working_resolution():
     with pytest.raises(_native.OverBudgetError, match="1100x1000 3-channel exemplar.*the exemplar is too big"):
         _native.synthesize_image(big, width=40, height=40, levels=1, max_exemplar_size=0, memory_budget=256 << 20,
                                  method="optimization")
-    # Turned, the exemplar analysed is the 2s x 2s mosaic of its central square: the message says so.
-    with pytest.raises(_native.OverBudgetError, match="2000x2000 3-channel exemplar mosaic \\(its four quarter "
+    # Turned, the exemplar analysed is the mosaic of its central square's quadrants in their turns
+    # (1000 x 1000 here: quadrants of 500 pixels): the message says so.
+    with pytest.raises(_native.OverBudgetError, match="1000x1000 3-channel exemplar mosaic \\(its four quarter "
                        "turns, rotate_exemplar\\).*set rotate_exemplar to off"):
         _native.synthesize_image(big, width=40, height=40, levels=1, max_exemplar_size=0, memory_budget=512 << 20,
                                  method="optimization", rotate_exemplar=True)

@@ -105,6 +105,11 @@ double exemplar_feature_stretch(const Image& exemplar);
 /// the nearest above are walnut 1.37, parque3 1.41 and wood5 1.45, which
 /// run one way (docs/solid.md, fifteenth pass).
 constexpr double kRoundFeatureStretch = 1.3;
+/// The quarter turns' mosaic takes up to this many pixels of the
+/// exemplar's central square per turn, or its quadrants when they are larger
+/// (solid/exemplar_rotations.hpp): turning then costs at most the windows of
+/// a 256^2 exemplar more than not turning.
+constexpr int kMaxTurnedTile = 128;
 /// Solids' rotate_exemplar (SolidOptions).
 constexpr RotateExemplar kSolidRotateExemplar = RotateExemplar::Auto;
 

@@ -10,23 +10,28 @@
 
 namespace exsynth::solid {
 
+int quarter_turn_tile(int square) { return std::max(std::min(square, kMaxTurnedTile), square / 2); }
+
 Image quarter_turn_mosaic(const Image& ex) {
   const int s = std::min(ex.width(), ex.height()), c = ex.channels();
+  const int t = quarter_turn_tile(s);
   const int x0 = (ex.width() - s) / 2, y0 = (ex.height() - s) / 2;  // the central square
-  Image out(2 * s, 2 * s, c);
-  // Quarter q at (qx, qy) turned q x 90 degrees clockwise: its pixel (x, y)
-  // is the square's pixel at the inverse turn of (x, y).
+  Image out(2 * t, 2 * t, c);
+  // Quarter q at (qx, qy) is the t x t corner (qx, qy) of the central square
+  // turned q x 90 degrees clockwise: its pixel (x, y) is the corner's pixel
+  // at the inverse turn of (x, y).
   for (int q = 0; q < 4; ++q) {
-    const int qx = (q & 1) * s, qy = (q >> 1) * s;
-    for (int y = 0; y < s; ++y)
-      for (int x = 0; x < s; ++x) {
+    const int qx = (q & 1) * t, qy = (q >> 1) * t;
+    const int cx = x0 + (q & 1) * (s - t), cy = y0 + (q >> 1) * (s - t);
+    for (int y = 0; y < t; ++y)
+      for (int x = 0; x < t; ++x) {
         int sx = x, sy = y;
-        for (int t = 0; t < q; ++t) {  // undo one clockwise turn: (x, y) <- (y, s - 1 - x)
-          const int nx = sy, ny = s - 1 - sx;
+        for (int k = 0; k < q; ++k) {  // undo one clockwise turn: (x, y) <- (y, t - 1 - x)
+          const int nx = sy, ny = t - 1 - sx;
           sx = nx;
           sy = ny;
         }
-        std::copy_n(ex.data() + ex.offset(x0 + sx, y0 + sy), c, out.data() + out.offset(qx + x, qy + y));
+        std::copy_n(ex.data() + ex.offset(cx + sx, cy + sy), c, out.data() + out.offset(qx + x, qy + y));
       }
   }
   return out;
