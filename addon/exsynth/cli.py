@@ -187,7 +187,7 @@ def _parser():
                    help="with --method optimization: also match the exemplar turned by 90, 180 and 270 degrees, "
                    "for textures with no preferred direction (cracks, cells), whose cells otherwise line up along "
                    "one diagonal; auto = when the exemplar's features are round, not for wood or bricks; on (the "
-                   "flag alone) = always, about 1.4x the time at --size 128 (default %(default)s)")
+                   "flag alone) = always, about 1.4x the time at --size 128 for exemplars under 256 px (default %(default)s)")
     p.add_argument("--histogram-values", type=_finite, default=_native.SOLID_DEFAULT_HISTOGRAM_VALUES,
                    help="with --method optimization: how strongly each voxel's exemplar colour is picked to match "
                    "the exemplar's histogram (contrast); above 0.5 it oscillates, 0 = off (default %(default)s)")
