@@ -99,11 +99,14 @@ RotateExemplar rotate_exemplar_from_name(const std::string& name);
 /// one pixel, exceeds 0.3); 1 = round features. exsynth.quality.lobe_stretch
 /// is the same measure.
 double exemplar_feature_stretch(const Image& exemplar);
-/// RotateExemplar::Auto turns exemplars whose stretch is below this. Of 33
-/// gimp-data and bundled exemplars at 128^2, those below are crackedground
-/// 1.04, java 1.07, amethyst 1.15, marble2 1.18, paper 1.24, terra 1.28;
-/// the nearest above are walnut 1.37, parque3 1.41 and wood5 1.45, which
-/// run one way (docs/solid.md, fifteenth pass).
+/// RotateExemplar::Auto turns exemplars whose stretch is below this. Of 46
+/// gimp-data and bundled exemplars at 128^2, those below are leopard 1.01,
+/// crackedground 1.04, java 1.07, amethyst 1.15, marble2 1.18, sky 1.21,
+/// paper 1.24 and terra 1.28, none with a direction; the nearest above,
+/// pool 1.31, walnut 1.37, marble3 1.38, parque3 1.41 and wood5 1.45, mix
+/// water and marble with wood that runs one way (docs/solid.md, fifteenth
+/// pass). Conservative: round-ish exemplars with a mild direction
+/// (brownground 1.58, granite1 1.70) stay unturned.
 constexpr double kRoundFeatureStretch = 1.3;
 /// The quarter turns' mosaic takes up to this many pixels of the
 /// exemplar's central square per turn, or its quadrants when they are larger
