@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 #include <tbb/global_control.h>
 
+#include <atomic>
 #include <thread>
 #include <vector>
 
@@ -33,6 +34,42 @@ TEST(ExecContext, StageProgressMapsOntoItsRange) {
   EXPECT_DOUBLE_EQ(ctx.progress(), 0.75);
   ctx.set_progress(7);
   EXPECT_DOUBLE_EQ(ctx.progress(), 1.0);  // clamped
+}
+
+// Chunks finishing together may report their counts out of order; the bar
+// never goes back within a stage (raise_progress), and a new stage still
+// sets its start.
+TEST(ExecContext, ProgressNeverGoesBackWithinAStage) {
+  ExecContext ctx;
+  ctx.set_span(0.2, 0.6);
+  ctx.raise_progress(0.5);
+  ctx.raise_progress(0.25);  // a late, smaller count
+  EXPECT_DOUBLE_EQ(ctx.progress(), 0.4);
+  ctx.set_progress(0.0);  // set_progress may lower it: a stage's start
+  EXPECT_DOUBLE_EQ(ctx.progress(), 0.2);
+  // Many threads advancing one stage while another samples the bar.
+  ctx.set_span(0.0, 1.0);
+  StageProgress stage(&ctx, "stress", 0.0, 1.0, 8 * 20000);
+  std::atomic<bool> running{true};
+  int backwards = 0;
+  std::thread watch([&] {
+    double last = 0.0;
+    while (running.load()) {
+      const double p = ctx.progress();
+      backwards += p < last;
+      last = p;
+    }
+  });
+  std::vector<std::thread> workers;
+  for (int t = 0; t < 8; ++t)
+    workers.emplace_back([&] {
+      for (int i = 0; i < 20000; ++i) stage.advance();
+    });
+  for (std::thread& w : workers) w.join();
+  running = false;
+  watch.join();
+  EXPECT_EQ(backwards, 0);
+  EXPECT_DOUBLE_EQ(ctx.progress(), 1.0);
 }
 
 TEST(ExecContext, ASpanGivesOneCallItsShareOfTheBar) {

@@ -29,6 +29,18 @@ class ExecContext {
     const double lo = span_lo_.load(std::memory_order_relaxed), hi = span_hi_.load(std::memory_order_relaxed);
     progress_.store(lo + p * (hi - lo), std::memory_order_relaxed);
   }
+  /// As set_progress, but never lowers the progress shown: parallel chunks
+  /// report through it (StageProgress::advance), and two that finish
+  /// together may store their counts out of order (a bar going back from
+  /// 0.185 to 0.1846 failed a Blender test in CI).
+  void raise_progress(double p) {
+    p = p < 0 ? 0 : (p > 1 ? 1 : p);
+    const double lo = span_lo_.load(std::memory_order_relaxed), hi = span_hi_.load(std::memory_order_relaxed);
+    const double value = lo + p * (hi - lo);
+    double shown = progress_.load(std::memory_order_relaxed);
+    while (value > shown && !progress_.compare_exchange_weak(shown, value, std::memory_order_relaxed)) {
+    }
+  }
   /// A job made of several calls gives each its share of one progress bar:
   /// set_span(0.2, 0.9) before a call makes that call's 0..1 read 0.2..0.9.
   /// Set it between calls, not while one runs. Default: [0, 1].
@@ -96,7 +108,7 @@ class StageProgress {
   }
   void advance(std::size_t units = 1) {
     std::size_t done = done_.fetch_add(units, std::memory_order_relaxed) + units;
-    if (ctx_) ctx_->set_progress(lo_ + (hi_ - lo_) * double(done) / double(total_));
+    if (ctx_) ctx_->raise_progress(lo_ + (hi_ - lo_) * double(done) / double(total_));
   }
   ExecContext* context() const { return ctx_; }
 
