@@ -191,9 +191,7 @@ void bind_solid(py::module_& m) {
   m.attr("SOLID_DEFAULT_FEATURE_THRESHOLD") = SolidOptions{}.feature_threshold;
   m.attr("SOLID_MAX_FEATURE_THRESHOLD") = kMaxFeatureThreshold;
   m.attr("SOLID_DEFAULT_ROTATE_EXEMPLAR") = rotate_exemplar_name(SolidOptions{}.rotate_exemplar);
-  m.attr("ROTATE_EXEMPLAR_CHOICES") = py::make_tuple(rotate_exemplar_name(RotateExemplar::Off),
-                                                     rotate_exemplar_name(RotateExemplar::On),
-                                                     rotate_exemplar_name(RotateExemplar::Auto));
+  m.attr("ROTATE_EXEMPLAR_CHOICES") = py::tuple(py::cast(rotate_exemplar_names()));
   m.attr("ROUND_FEATURE_STRETCH") = kRoundFeatureStretch;
   m.def(
       "exemplar_feature_stretch",

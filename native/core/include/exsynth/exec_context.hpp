@@ -24,19 +24,13 @@ class ExecContext {
 
   /// Progress p in [0, 1] of the current call, shown as lo + p (hi - lo)
   /// of the whole job (see set_span).
-  void set_progress(double p) {
-    p = p < 0 ? 0 : (p > 1 ? 1 : p);
-    const double lo = span_lo_.load(std::memory_order_relaxed), hi = span_hi_.load(std::memory_order_relaxed);
-    progress_.store(lo + p * (hi - lo), std::memory_order_relaxed);
-  }
+  void set_progress(double p) { progress_.store(in_span(p), std::memory_order_relaxed); }
   /// As set_progress, but never lowers the progress shown: parallel chunks
   /// report through it (StageProgress::advance), and two that finish
   /// together may store their counts out of order (a bar going back from
   /// 0.185 to 0.1846 failed a Blender test in CI).
   void raise_progress(double p) {
-    p = p < 0 ? 0 : (p > 1 ? 1 : p);
-    const double lo = span_lo_.load(std::memory_order_relaxed), hi = span_hi_.load(std::memory_order_relaxed);
-    const double value = lo + p * (hi - lo);
+    const double value = in_span(p);
     double shown = progress_.load(std::memory_order_relaxed);
     while (value > shown && !progress_.compare_exchange_weak(shown, value, std::memory_order_relaxed)) {
     }
@@ -74,6 +68,13 @@ class ExecContext {
   void on_check(std::function<void()> hook) { on_check_ = std::move(hook); }
 
  private:
+  // p clamped to [0, 1], mapped into the span.
+  double in_span(double p) const {
+    p = p < 0 ? 0 : (p > 1 ? 1 : p);
+    const double lo = span_lo_.load(std::memory_order_relaxed), hi = span_hi_.load(std::memory_order_relaxed);
+    return lo + p * (hi - lo);
+  }
+
   std::atomic<bool> cancelled_{false};
   std::atomic<double> progress_{0.0};
   std::atomic<double> span_lo_{0.0}, span_hi_{1.0};

@@ -89,6 +89,8 @@ enum class RotateExemplar {
   /// mortar and grain the wrong way.
   Auto,
 };
+/// The names of RotateExemplar's values, in its order.
+const std::vector<std::string>& rotate_exemplar_names();
 const char* rotate_exemplar_name(RotateExemplar r);
 /// "off", "on" or "auto"; InvalidInput naming them otherwise.
 RotateExemplar rotate_exemplar_from_name(const std::string& name);

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <string>
 #include <utility>
 #include <vector>
 
@@ -123,18 +124,19 @@ double exemplar_feature_stretch(const Image& ex) {
   return big <= 0.0 ? 1.0 : std::sqrt(big / small);
 }
 
-const char* rotate_exemplar_name(RotateExemplar r) {
-  switch (r) {
-    case RotateExemplar::Off: return "off";
-    case RotateExemplar::On: return "on";
-    case RotateExemplar::Auto: return "auto";
-  }
-  return "off";
-}
+namespace {
+
+// In RotateExemplar's order.
+const std::vector<std::string> kRotateNames{"off", "on", "auto"};
+
+}  // namespace
+
+const std::vector<std::string>& rotate_exemplar_names() { return kRotateNames; }
+const char* rotate_exemplar_name(RotateExemplar r) { return kRotateNames[std::size_t(r)].c_str(); }
 
 RotateExemplar rotate_exemplar_from_name(const std::string& name) {
-  for (RotateExemplar r : {RotateExemplar::Off, RotateExemplar::On, RotateExemplar::Auto})
-    if (name == rotate_exemplar_name(r)) return r;
+  for (std::size_t i = 0; i < kRotateNames.size(); ++i)
+    if (kRotateNames[i] == name) return RotateExemplar(i);
   throw InvalidInput("rotate_exemplar must be 'off', 'on' or 'auto', got '" + name + "'");
 }
 
