@@ -40,6 +40,15 @@ _ROTATE_EXEMPLAR_TEXT = {
 ROTATE_EXEMPLAR_ITEMS = tuple((c.upper(), *_ROTATE_EXEMPLAR_TEXT.get(c, (c.title(), c)))
                               for c in _native.ROTATE_EXEMPLAR_CHOICES)
 
+# The engine's interpolations for baking (_native.INTERPOLATION_CHOICES), likewise.
+_INTERPOLATION_TEXT = {
+    "cubic": ("Cubic", "Tricubic, kept within the surrounding voxels' range: voxel-sized grain and cracks "
+              "keep their contrast, no halos"),
+    "linear": ("Linear", "Trilinear: softer; voxel-sized detail loses about half its contrast"),
+}
+INTERPOLATION_ITEMS = tuple((c.upper(), *_INTERPOLATION_TEXT.get(c, (c.title(), c)))
+                            for c in _native.INTERPOLATION_CHOICES)
+
 # The direction-field presets (Direction Field and Geometric Texture).
 FIELD_PRESET_ITEMS = (
     ('AROUND_AXIS', "Around Axis", "Circles around the axis through the mesh's centre"),
@@ -194,6 +203,12 @@ class ExSynthSettings(bpy.types.PropertyGroup):
         name="Resolution",
         description="Width and height of each baked image, in pixels",
         default=1024, min=16, max=16384, soft_max=8192,
+    )
+    solid_bake_interpolation: EnumProperty(
+        name="Interpolation",
+        description="How each texel or face corner reads the solid between its voxels",
+        items=INTERPOLATION_ITEMS,
+        default=_native.DEFAULT_INTERPOLATION.upper(),
     )
     solid_new_uvs: BoolProperty(
         name="New UV Map",

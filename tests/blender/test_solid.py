@@ -343,6 +343,28 @@ def test_rebake_from_a_color_volume_made_elsewhere(cow, tmp_path):
     np.testing.assert_allclose(corner_colors(cow)[:, :3], expected, atol=1e-5)
 
 
+@pytest.mark.parametrize("interpolation", _native.INTERPOLATION_CHOICES)
+def test_rebake_reads_the_solid_with_the_chosen_interpolation(cow, tmp_path, interpolation):
+    values = np.random.default_rng(2).random((6, 5, 4, 3)).astype(np.float32) + 0.1
+    path = str(tmp_path / "noise.vdb")
+    _native.write_vdb(path, {"color": values}, (0.05, 0.05, 0.05), 0.1)
+    volume_obj = volume_io.new_volume_object("noise", path, 0.1, bpy.context.collection, jobs.Created())
+    s = settings()
+    assert s.solid_bake_interpolation == _native.DEFAULT_INTERPOLATION.upper()
+    s.solid_volume, s.solid_bake_target = volume_obj, 'ATTRIBUTE'
+    s.solid_bake_interpolation = interpolation.upper()
+    bpy.context.view_layer.update()
+    select_only(cow)
+    assert run("solid_rebake") == {'FINISHED'}
+    corners = world_corners(cow)
+    got = corner_colors(cow)[:, :3]
+    np.testing.assert_allclose(got, _native.sample_volume(values, (0.05, 0.05, 0.05), 0.1, corners,
+                                                          interpolation=interpolation), atol=1e-5)
+    other = next(c for c in _native.INTERPOLATION_CHOICES if c != interpolation)
+    assert np.abs(got - _native.sample_volume(values, (0.05, 0.05, 0.05), 0.1, corners,
+                                              interpolation=other)).max() > 0.01
+
+
 # ---- exemplar reading ------------------------------------------------------------------
 def test_exemplar_rows_are_flipped_to_top_first():
     image = bpy.data.images.new("halves", 6, 4, alpha=True)
@@ -578,6 +600,13 @@ def test_cli_solid_bakes_onto_a_mesh(tmp_path, capsys):
     lines = obj.read_text().splitlines()
     assert sum(l.startswith("vt ") for l in lines) > 100  # the UVs the bake used
     assert "% covered" in capsys.readouterr().out
+    # The same solid (same seed) read trilinearly: the same texels covered, other values.
+    soft = tmp_path / "bake" / "cow_linear.png"
+    assert cli.main(["solid", "--exemplar", CRACKED, *FAST, "--out", str(tmp_path / "s2.npy"), "--mesh", COW_OBJ,
+                     "--bake-out", str(soft), "--bake-size", "128", "--bake-interpolation", "linear"]) == 0
+    px_soft = image_pixels(bpy.data.images.load(str(soft)))[..., :3]
+    np.testing.assert_array_equal(px_soft.sum(axis=2) > 0, filled)
+    assert np.abs(px_soft - px).max() > 0.02
 
 
 def test_cli_image_writes_a_png_of_the_requested_size(tmp_path, capsys):
@@ -610,6 +639,8 @@ def test_cli_bad_arguments(tmp_path, monkeypatch, capsys):
         (["--exemplar", CRACKED, "--out", "s.npy", "--mesh", COW_OBJ], 2,
          "--mesh and --bake-out go together"),
         (["--exemplar", CRACKED, "--out", "s.npy", "--size", "0"], 2, "--size must be > 0"),
+        (["--exemplar", CRACKED, "--out", "s.npy", "--bake-interpolation", "nearest"], 2,
+         "--bake-interpolation: invalid choice: 'nearest'"),
         (["--exemplar", str(tiny), *FAST, "--method", "optimization", "--out", "s.npy"], 1,
          "smaller than the 8x8 neighbourhood"),
         (["--exemplar", str(tiny), *FAST, "--method", "coordinates", "--out", "s.npy"], 1,

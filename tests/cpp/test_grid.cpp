@@ -1,6 +1,7 @@
 // Sampling, resizing and Gaussian pyramids of images and volumes.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <string>
 
@@ -106,6 +107,55 @@ TEST(Sample, TrilinearIsExactOnLinearFunctions) {
           EXPECT_NEAR(all[c], f(x, y, z, c), 1e-5);
         }
       }
+}
+
+// Catmull-Rom reproduces polynomials up to degree 2 exactly: on a smooth,
+// monotone function away from the edges the range limit never binds.
+TEST(Sample, TricubicIsExactOnQuadraticsAndKeepsCentres) {
+  Volume vol(7, 6, 8, 2);
+  auto f = [](double x, double y, double z, int c) { return 0.3 * x * x + 0.2 * y * y + (c + 1) * 0.15 * z * z + x + c; };
+  for (int z = 0; z < 8; ++z)
+    for (int y = 0; y < 6; ++y)
+      for (int x = 0; x < 7; ++x)
+        for (int c = 0; c < 2; ++c) vol.at(x, y, z, c) = float(f(x, y, z, c));
+  float got[2];
+  for (double z = 1.0; z <= 6.0; z += 0.37)
+    for (double y = 1.0; y <= 4.0; y += 0.41)
+      for (double x = 1.0; x <= 5.0; x += 0.29) {
+        exsynth::sample_tricubic(vol, x, y, z, got);
+        for (int c = 0; c < 2; ++c) EXPECT_NEAR(got[c], f(x, y, z, c), 1e-4) << x << " " << y << " " << z;
+      }
+  const Volume noise = random_volume(5, 4, 6, 2, 9);
+  for (Boundary b : {Boundary::Clamp, Boundary::Wrap}) {
+    exsynth::sample_tricubic(noise, 3.0, 1.0, 4.0, got, b);
+    EXPECT_FLOAT_EQ(got[1], noise.at(3, 1, 4, 1));
+  }
+}
+
+// Each channel lies within the 8 nearest voxels' values (no halo), and the
+// wrap boundary repeats with the volume's period.
+TEST(Sample, TricubicStaysInTheCellsRangeAndWraps) {
+  const Volume vol = random_volume(4, 5, 6, 1, 11);
+  float got = 0.0f, again = 0.0f;
+  for (double z = -0.9; z < 5.0; z += 0.53)
+    for (double y = -0.7; y < 4.0; y += 0.47)
+      for (double x = -0.3; x < 3.0; x += 0.31) {
+        exsynth::sample_tricubic(vol, x, y, z, &got, Boundary::Wrap);
+        exsynth::sample_tricubic(vol, x + 4.0, y - 10.0, z + 6.0, &again, Boundary::Wrap);
+        EXPECT_NEAR(got, again, 1e-5);
+        const int x0 = int(std::floor(x)), y0 = int(std::floor(y)), z0 = int(std::floor(z));
+        float lo = 1e9f, hi = -1e9f;
+        for (int k = 0; k < 2; ++k)
+          for (int j = 0; j < 2; ++j)
+            for (int i = 0; i < 2; ++i) {
+              const float v = vol.at((x0 + i + 4) % 4, (y0 + j + 5) % 5, (z0 + k + 6) % 6);
+              lo = std::min(lo, v), hi = std::max(hi, v);
+            }
+        EXPECT_GE(got, lo);
+        EXPECT_LE(got, hi);
+      }
+  EXPECT_EQ(exsynth::interpolation_from_name("cubic", "interpolation"), exsynth::Interpolation::Cubic);
+  EXPECT_THROW(exsynth::interpolation_from_name("bicubic", "interpolation"), exsynth::InvalidInput);
 }
 
 TEST(Sample, ClampHoldsEdgeValues) {

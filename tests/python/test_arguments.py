@@ -54,10 +54,11 @@ FUNCTIONS = {
         "max_pca_dims": ("int", 1, 4096), "ann_eps": ("real", 0, None), "coherence": ("real", 0, None),
         "coherence_slack": ("real", 0, None), "cull_distance": ("real", None, None), "remove_debris": "bool",
         "memory_budget": "budget", "seed": "seed", "ctx": "ctx"}),
-    "sample_volume": (call("sample_volume", VOL, [0, 0, 0], 1.0, PTS), {"wrap": "bool", "ctx": "ctx"}),
+    "sample_volume": (call("sample_volume", VOL, [0, 0, 0], 1.0, PTS), {"wrap": "bool", "interpolation": "str",
+                                                                         "ctx": "ctx"}),
     "bake_volume_to_uv": (call("bake_volume_to_uv", VOL, [0, 0, 0], 1.0, POS, UVS, width=8, height=8), {
         "width": ("int", 1, 16384), "height": ("int", 1, 16384), "margin": ("int", 0, 64), "wrap": "bool",
-        "ctx": "ctx"}),
+        "interpolation": "str", "ctx": "ctx"}),
     "isosurface": (call("isosurface", SDF, [0, 0, 0], voxel_size=1.0), {
         "voxel_size": ("real", 0, None), "isovalue": ("real", None, None), "adaptivity": ("real", 0, 1),
         "invert": "bool", "ctx": "ctx"}),

@@ -34,12 +34,18 @@ IMAGE_EXTENSIONS = (".png", ".jpg", ".jpeg", ".tif", ".tiff", ".exr", ".hdr", ".
 @dataclasses.dataclass
 class BakeOptions:
     resolution: int = 1024  # width and height of baked images
+    interpolation: str = _native.DEFAULT_INTERPOLATION  # how texels and corners read the solid (INTERPOLATION_CHOICES)
 
     @property
     def margin(self):
         # Texels filled around UV islands, so mip-mapping and filtering do
         # not pull in the background: ~0.8 % of the image, at least 4.
         return max(4, self.resolution // 128)
+
+
+def bake_options(settings):
+    """The scene's bake settings as BakeOptions."""
+    return BakeOptions(settings.solid_bake_resolution, settings.solid_bake_interpolation.lower())
 
 
 @dataclasses.dataclass
@@ -62,11 +68,13 @@ def bake_targets(volume, origin, voxel_size, targets, options, ctx, span=(0.0, 1
         if target.mode == bake_io.IMAGE:
             pixels, mask = _native.bake_volume_to_uv(
                 volume, origin, voxel_size, target.positions, target.uvs,
-                options.resolution, options.resolution, wrap=True, margin=options.margin, ctx=ctx,
+                options.resolution, options.resolution, wrap=True, margin=options.margin,
+                interpolation=options.interpolation, ctx=ctx,
             )
             baked.append(Baked(target, pixels=pixels, covered=float(np.mean(mask == 1))))
         else:
-            colors = _native.sample_volume(volume, origin, voxel_size, target.positions, wrap=True, ctx=ctx)
+            colors = _native.sample_volume(volume, origin, voxel_size, target.positions, wrap=True,
+                                           interpolation=options.interpolation, ctx=ctx)
             baked.append(Baked(target, colors=colors))
     return baked
 
@@ -370,7 +378,7 @@ class EXSYNTH_OT_solid_texture(JobOperator, bpy.types.Operator):
             histogram_values=settings.solid_histogram_values,
             scale=settings.solid_scale, seed=settings.seed,
             memory_budget=settings.memory_budget_bytes, encoding=encoding, anchor=anchor,
-            targets=targets, bake=BakeOptions(settings.solid_bake_resolution),
+            targets=targets, bake=bake_options(settings),
         )
 
     def finish(self, context, result, created):
@@ -428,7 +436,7 @@ class EXSYNTH_OT_solid_rebake(JobOperator, bpy.types.Operator):
         return RebakeJob(
             name=volume_obj.name, path=path, size=size,
             encoding=meta.get("encoding", image_io.LINEAR), targets=targets,
-            bake=BakeOptions(settings.solid_bake_resolution),
+            bake=bake_options(settings),
         )
 
     def finish(self, context, result, created):

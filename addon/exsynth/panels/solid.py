@@ -31,6 +31,7 @@ class EXSYNTH_PT_solid(SidebarPanel, bpy.types.Panel):
         if settings.solid_bake_target == 'IMAGE':
             col.prop(settings, "solid_bake_resolution")
             col.prop(settings, "solid_new_uvs")
+        col.prop(settings, "solid_bake_interpolation")
 
         meshes = [o for o in context.selected_objects if o.type == 'MESH']
         box = layout.box()

@@ -15,9 +15,9 @@ void check_volume(const Volume& vol) {
   if (!(vol.transform().voxel_size > 0)) throw InvalidInput("the volume's voxel_size must be > 0");
 }
 
-void sample_at(const Volume& vol, const Eigen::Vector3f& p, Boundary b, float* out) {
+void sample_at(const Volume& vol, const Eigen::Vector3f& p, Boundary b, Interpolation interp, float* out) {
   const auto idx = vol.transform().world_to_index(p.x(), p.y(), p.z());
-  sample_trilinear(vol, idx[0], idx[1], idx[2], out, b);
+  sample_volume_at(vol, idx[0], idx[1], idx[2], out, interp, b);
 }
 
 constexpr int kBand = 16;  // image rows per parallel task; a task owns its rows
@@ -50,7 +50,7 @@ bool covers_a_texel_centre(const Eigen::Vector2f t[3]) {
 }  // namespace
 
 void sample_volume(const Volume& vol, const std::vector<Eigen::Vector3f>& points, bool wrap, float* out,
-                   ExecContext* ctx) {
+                   ExecContext* ctx, Interpolation interp) {
   check_volume(vol);
   for (std::size_t i = 0; i < points.size(); ++i)
     if (!points[i].allFinite())
@@ -59,7 +59,7 @@ void sample_volume(const Volume& vol, const std::vector<Eigen::Vector3f>& points
   StageProgress progress(ctx, "sample volume", 0.0, 1.0, points.size());
   const int C = vol.channels();
   parallel_chunks(points.size(), 4096, progress, [&](std::size_t begin, std::size_t end) {
-    for (std::size_t i = begin; i < end; ++i) sample_at(vol, points[i], b, out + i * C);
+    for (std::size_t i = begin; i < end; ++i) sample_at(vol, points[i], b, interp, out + i * C);
   });
 }
 
@@ -122,7 +122,7 @@ BakeResult bake_volume_to_uv(const Volume& vol, const std::vector<std::array<Eig
                         w2 = edge_function(t[0], t[1], p) / area;
             if (w0 < eps || w1 < eps || w2 < eps) continue;
             const Eigen::Vector3f pos = w0 * positions[f][0] + w1 * positions[f][1] + w2 * positions[f][2];
-            sample_at(vol, pos, b, r.image.data() + r.image.offset(x, y));
+            sample_at(vol, pos, b, opt.interpolation, r.image.data() + r.image.offset(x, y));
             r.mask[std::size_t(y) * W + x] = 1;
             covered_any = true;
           }
@@ -134,7 +134,7 @@ BakeResult bake_volume_to_uv(const Volume& vol, const std::vector<std::array<Eig
           const int x = int(std::lround(c.x())), y = int(std::lround(c.y()));
           if (x >= 0 && x < W && y >= row0 && y < row1 && r.mask[std::size_t(y) * W + x] != 1) {
             const Eigen::Vector3f pos = (positions[f][0] + positions[f][1] + positions[f][2]) / 3.0f;
-            sample_at(vol, pos, b, r.image.data() + r.image.offset(x, y));
+            sample_at(vol, pos, b, opt.interpolation, r.image.data() + r.image.offset(x, y));
             r.mask[std::size_t(y) * W + x] = 3;
           }
         }
