@@ -9,7 +9,9 @@ docstring: nn_rel, sharpness, contrast, hist_emd, copy_rate, max_copy_frac,
 elongation); solids are the mean over x, y and z slices, but their
 elongation is measured in 3D (1 = features as long for their width as the
 exemplar's; above 1 stretched one way, as parallel sheets or tubes; below 1
-the exemplar's long features, veins or courses, lost). Then speed: whole-process time
+the exemplar's long features, veins or courses, lost). Then which of issue
+10's targets each kind of output meets (the peer's rows against the image
+targets, for comparison). Then speed: whole-process time
 for 128^2 -> 256^2 (the Python module vs the gmic command, alternating in
 the same run, median of 3) and a 128^3 RGB solid.
 
@@ -53,6 +55,12 @@ EXEMPLARS = {  # name: source
 }
 SOLID_ONLY = ("method", "coordinate_coherence_k")  # options synthesize_image does not take
 KEYS = ("nn_rel", "sharpness", "contrast", "hist_emd", "copy_rate", "max_copy_frac", "elongation")
+# Issue 10's targets, per kind of output: (key, "min" | "max", bound).
+TARGETS = {
+    "solid": (("sharpness", "min", 0.85), ("contrast", "min", 0.85), ("hist_emd", "max", 4.0), ("nn_rel", "max", 0.35)),
+    "image": (("sharpness", "min", 0.9), ("nn_rel", "max", 0.20), ("copy_rate", "max", 0.35),
+              ("max_copy_frac", "max", 0.25)),
+}
 WORST = {"nn_rel": max, "hist_emd": max, "copy_rate": max, "max_copy_frac": max, "sharpness": min, "contrast": min,
          "elongation": lambda v: max(v, key=lambda e: abs(np.log(e)))}  # farthest from 1 either way
 
@@ -132,6 +140,36 @@ def calibration(names, quality, native, image_opts, peers, tmp):
     print(f"{'mean':<16} " + " ".join(f"{v:>{w}.2f}" for v, w in zip(mean, CALIBRATION_WIDTHS)))
 
 
+def target_kind(label):
+    return "solid" if label.startswith("solid") else "image" if "256^2" in label else None
+
+
+def missed(kind, m):
+    """The targets output m misses: [(key, value, bound)]."""
+    return [(k, m[k], b) for k, side, b in TARGETS[kind] if (m[k] < b if side == "min" else m[k] > b)]
+
+
+def print_targets(totals):
+    """Per kind of output, how many exemplars meet each of issue 10's targets, and the misses."""
+    print()
+    print("issue 10's targets: " + "; ".join(
+        f"{kind}s " + ", ".join(f"{k} {'>=' if side == 'min' else '<='} {b:g}" for k, side, b in TARGETS[kind])
+        for kind in TARGETS))
+    for label, named in totals.items():
+        kind = target_kind(label)
+        if kind is None:
+            continue
+        misses = {name: missed(kind, m) for name, m in named}
+        met = sum(len(TARGETS[kind]) - len(v) for v in misses.values())
+        per_key = ", ".join(f"{k} {sum(all(mk != k for mk, _, _ in v) for v in misses.values())}/{len(named)}"
+                            for k, _, _ in TARGETS[kind])
+        print(f"  {label}: {met} of {len(named) * len(TARGETS[kind])} met ({per_key}); every target on "
+              f"{sum(not v for v in misses.values())} of {len(named)} exemplars")
+        for name, v in misses.items():
+            if v:
+                print(f"    {name} misses " + ", ".join(f"{k} {val:.2f}" for k, val, _ in v))
+
+
 def row(label, m):
     return f"{label:<44} " + " ".join(f"{m[k]:>9.2f}" for k in KEYS)
 
@@ -185,13 +223,15 @@ def main(argv=None):
                 E, gmic_image(ex_png, os.path.join(tmp, name + "_gmic.png")))))
         for label, run in cases:
             m = run()
-            totals.setdefault(label, []).append(m)
+            totals.setdefault(label, []).append((name, m))
             print(row(f"{name}: {label}", m), flush=True)
     print("-" * len(header))
-    for label, ms in totals.items():
+    for label, named in totals.items():
+        ms = [m for _, m in named]
         print(row(f"mean over {len(ms)} exemplars: {label}", {k: float(np.mean([m[k] for m in ms])) for k in KEYS}))
         print(row(f"worst of {len(ms)} exemplars: {label}",
                   {k: WORST[k]([m[k] for m in ms]) for k in KEYS}))
+    print_targets(totals)
 
     if args.solids_only:
         return 0
