@@ -23,6 +23,13 @@ numbers are averaged per axis, then over the axes.
              `copy_eps`) and belong to a 4-connected group of >= `min_cells`
              such patches with the same exemplar offset: verbatim copies.
   max_copy_frac  pixel area of the largest such copied region / exemplar area.
+  speckle    single-pixel noise: the RMS of the luminance minus its 3 x 3
+             median (edges replicated), output / exemplar's. Above 1 the
+             output has more lone pixels than the exemplar, which raises
+             sharpness without any detail: solids of exemplar values scored
+             sharpness 1.10 with speckle 1.72 on granite1, whose slices look
+             like salt and pepper (issue 10, sixteenth pass). Not in the
+             shared tool (texmetrics.py): a project-side diagnostic.
   elongation the output's stretch / the exemplar's (1 = as isotropic as the
              exemplar). Stretch = sqrt(largest / smallest eigenvalue) of the
              second moments of the central lobe of the luminance's
@@ -86,6 +93,7 @@ class Exemplar:
         self.contrast = float(np.sqrt(self.img.reshape(-1, 3).var(0).mean()))
         self.grad = grad_energy(self.img)
         self.stretch = lobe_stretch(luminance(self.img))
+        self.speckle = median_residual(luminance(self.img))
 
     def nearest(self, Q, candidates=8, chunk=2048):
         """(squared distance, index) of each row of Q's nearest exemplar patch."""
@@ -167,6 +175,14 @@ def grad_energy(img):
     return float(np.sqrt(gx ** 2 + gy ** 2).mean())
 
 
+def median_residual(lum):
+    """RMS of a 2D luminance minus its 3 x 3 median (edges replicated)."""
+    h, w = lum.shape
+    p = np.pad(lum, 1, mode="edge")
+    med = np.median(np.stack([p[dy:dy + h, dx:dx + w] for dy in range(3) for dx in range(3)]), axis=0)
+    return float(np.sqrt(np.mean((lum - med) ** 2)))
+
+
 def hist_emd(ex, out, bins=32):
     emd = []
     for c in range(ex.shape[-1]):
@@ -235,6 +251,7 @@ def image_metrics(E, out, stride=2, copy_eps=1.0, min_cells=16):
                 hist_emd=hist_emd(E.img, out), sharpness=grad_energy(out) / max(E.grad, 1e-9),
                 contrast=out_contrast / max(E.contrast, 1e-9), copy_rate=float(copied.mean()),
                 max_copy_frac=best / float(E.img.shape[0] * E.img.shape[1]),
+                speckle=median_residual(luminance(out)) / max(E.speckle, 1e-9),
                 elongation=lobe_stretch(luminance(out)) / E.stretch)
 
 

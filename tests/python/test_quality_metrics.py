@@ -1,5 +1,5 @@
-"""exsynth.quality's elongation measure: its autocorrelation against a
-brute-force sum, and the stretch on inputs whose answer is known."""
+"""exsynth.quality's elongation and speckle measures: the autocorrelation against a
+brute-force sum and a direct median, and both on inputs whose answer is known."""
 import itertools
 
 import numpy as np
@@ -75,3 +75,31 @@ def test_the_exemplar_itself_has_elongation_one():
     ex = (np.repeat(np.repeat(blobs((64, 32), 2.0), 2, axis=1)[..., None], 3, -1) * 50 + 128).clip(0, 255)
     E = quality.Exemplar(ex)
     assert quality.image_metrics(E, ex)["elongation"] == pytest.approx(1.0, abs=1e-12)
+
+
+def test_median_residual_matches_a_direct_3x3_median():
+    a = np.random.default_rng(3).random((6, 7)) * 255
+    want = np.empty_like(a)
+    for i, j in itertools.product(range(6), range(7)):
+        rows = [min(max(i + d, 0), 5) for d in (-1, 0, 1)]
+        cols = [min(max(j + d, 0), 6) for d in (-1, 0, 1)]
+        want[i, j] = np.median([a[r, c] for r in rows for c in cols])
+    assert quality.median_residual(a) == pytest.approx(float(np.sqrt(np.mean((a - want) ** 2))), rel=1e-12)
+
+
+def test_speckle_sees_lone_pixels_that_sharpness_counts_as_detail():
+    ex = (np.repeat(np.repeat(blobs((64, 32), 2.0), 2, axis=1)[..., None], 3, -1) * 50 + 128).clip(0, 255)
+    E = quality.Exemplar(ex)
+    assert quality.image_metrics(E, ex)["speckle"] == pytest.approx(1.0, abs=1e-12)
+    # Every 7th pixel swapped with a random pixel of the image: the same
+    # histogram, lone pixels everywhere.
+    rng = np.random.default_rng(4)
+    flat = ex.reshape(-1, 3).copy()
+    lone = np.arange(0, len(flat), 7)
+    flat[lone] = flat[rng.integers(0, len(flat), len(lone))]
+    m = quality.image_metrics(E, flat.reshape(ex.shape))
+    assert m["sharpness"] > 1.1 and m["speckle"] > 1.5
+    # A blur has fewer lone pixels than the exemplar, and less sharpness.
+    blurred = np.stack([quality.gaussian_blur(ex[..., c], 1.0) for c in range(3)], -1)
+    m = quality.image_metrics(E, blurred)
+    assert m["speckle"] < 0.8 and m["sharpness"] < 0.9
