@@ -16,10 +16,10 @@ namespace exsynth {
 
 /// out[i * C + c] = channel c at world point i (the volume's transform),
 /// read with `interp` (sample.hpp); wrap = the volume repeats (a tiling
-/// solid), else clamp. Cubic is the default: on a 128^3 crackedground solid
-/// baked at ~3.7 texels per voxel, trilinear halved the texels' mean
-/// gradient against nearest voxels (2.47 vs 4.84 grey levels), cubic kept
-/// 3.09 with no blocks (docs/solid.md).
+/// solid), else clamp. Cubic is the default: a 128^3 crackedground solid
+/// baked at 3.7 texels per voxel kept 0.52 of its nearest voxels' texel-to-
+/// texel difference read trilinearly, 0.64 tricubically, with no blocks
+/// (bench/bench_bake.py, docs/solid.md).
 void sample_volume(const Volume& vol, const std::vector<Eigen::Vector3f>& points, bool wrap, float* out,
                    ExecContext* ctx = nullptr, Interpolation interp = Interpolation::Cubic);
 
