@@ -46,7 +46,7 @@ Interpolation interpolation_arg(const py::handle& v) {
 
 void bind_bake(py::module_& m) {
   m.attr("INTERPOLATION_CHOICES") = py::tuple(py::cast(interpolation_names()));
-  const std::string default_interp = interpolation_names()[std::size_t(BakeOptions{}.interpolation)];
+  const std::string default_interp = interpolation_names()[std::size_t(kDefaultInterpolation)];
   m.attr("DEFAULT_INTERPOLATION") = default_interp;
   m.def(
       "sample_volume",

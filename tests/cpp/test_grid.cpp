@@ -88,15 +88,22 @@ TEST(Sample, BilinearIsExactOnLinearFunctions) {
   }
 }
 
+// A volume whose voxel (x, y, z) holds f(x, y, z, c) in channel c.
+template <class F>
+Volume volume_of(int nx, int ny, int nz, int channels, F f) {
+  Volume vol(nx, ny, nz, channels);
+  for (int z = 0; z < nz; ++z)
+    for (int y = 0; y < ny; ++y)
+      for (int x = 0; x < nx; ++x)
+        for (int c = 0; c < channels; ++c) vol.at(x, y, z, c) = float(f(x, y, z, c));
+  return vol;
+}
+
 TEST(Sample, TrilinearIsExactOnLinearFunctions) {
-  Volume vol(5, 6, 4, 3);
   auto f = [](double x, double y, double z, int c) {
     return (c + 1) * x - 2.0 * y + 0.5 * z + c;
   };
-  for (int z = 0; z < 4; ++z)
-    for (int y = 0; y < 6; ++y)
-      for (int x = 0; x < 5; ++x)
-        for (int c = 0; c < 3; ++c) vol.at(x, y, z, c) = float(f(x, y, z, c));
+  const Volume vol = volume_of(5, 6, 4, 3, f);
   float all[3];
   for (double z = 0; z <= 3.0; z += 0.43)
     for (double y = 0; y <= 5.0; y += 0.61)
@@ -112,12 +119,8 @@ TEST(Sample, TrilinearIsExactOnLinearFunctions) {
 // Catmull-Rom reproduces polynomials up to degree 2 exactly: on a smooth,
 // monotone function away from the edges the range limit never binds.
 TEST(Sample, TricubicIsExactOnQuadraticsAndKeepsCentres) {
-  Volume vol(7, 6, 8, 2);
   auto f = [](double x, double y, double z, int c) { return 0.3 * x * x + 0.2 * y * y + (c + 1) * 0.15 * z * z + x + c; };
-  for (int z = 0; z < 8; ++z)
-    for (int y = 0; y < 6; ++y)
-      for (int x = 0; x < 7; ++x)
-        for (int c = 0; c < 2; ++c) vol.at(x, y, z, c) = float(f(x, y, z, c));
+  const Volume vol = volume_of(7, 6, 8, 2, f);
   float got[2];
   for (double z = 1.0; z <= 6.0; z += 0.37)
     for (double y = 1.0; y <= 4.0; y += 0.41)

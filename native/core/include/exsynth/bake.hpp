@@ -21,7 +21,7 @@ namespace exsynth {
 /// texel difference read trilinearly, 0.64 tricubically, with no blocks
 /// (bench/bench_bake.py, docs/solid.md).
 void sample_volume(const Volume& vol, const std::vector<Eigen::Vector3f>& points, bool wrap, float* out,
-                   ExecContext* ctx = nullptr, Interpolation interp = Interpolation::Cubic);
+                   ExecContext* ctx = nullptr, Interpolation interp = kDefaultInterpolation);
 
 /// Option limits, checked by bake_volume_to_uv.
 constexpr int kMaxBakeSize = 16384;   ///< texels on a side
@@ -32,7 +32,7 @@ struct BakeOptions {
   int height = 1024;
   int margin = 4;        ///< texels of padding grown around each UV island (hides seams when mip-mapping)
   bool wrap = true;      ///< the volume repeats
-  Interpolation interpolation = Interpolation::Cubic;  ///< how texels read the volume (see sample_volume)
+  Interpolation interpolation = kDefaultInterpolation;  ///< how texels read the volume (see sample_volume)
   std::uint64_t seed = 0;  ///< unused: baking is deterministic
 };
 

@@ -13,6 +13,8 @@ namespace exsynth {
 /// limited to the range of the 8 surrounding voxels, so it adds no halos and
 /// no values outside them (crisper: voxel-scale detail keeps its contrast).
 enum class Interpolation { Linear, Cubic };
+/// The default wherever a solid is put on a surface (sample_volume, BakeOptions, the bindings).
+constexpr Interpolation kDefaultInterpolation = Interpolation::Cubic;
 /// The names the bindings, add-on and CLI take, in enum order ("linear", "cubic").
 const std::vector<std::string>& interpolation_names();
 /// The Interpolation a name gives; InvalidInput naming `what` and the choices otherwise.
