@@ -30,7 +30,7 @@ RotateExemplar rotate_arg(const py::handle& v, const std::string& k) {
 constexpr const char* kCommonNames =
     "levels, neighborhood, iterations, finest_iterations, r, pca_variance, max_pca_dims, search, coherence_k, "
     "random_candidates, ann_eps, histogram_matching, histogram_bins, histogram_strength, mean_shift, "
-    "coherent_upsampling, exemplar_values, histogram_values, histogram_value_rounds, histogram_value_window, feature_weight, feature_threshold, rotate_exemplar, tileable, max_exemplar_size, memory_budget, seed";
+    "coherent_upsampling, exemplar_values, histogram_values, histogram_value_rounds, histogram_value_window, structure_sigma, feature_weight, feature_threshold, rotate_exemplar, tileable, max_exemplar_size, memory_budget, seed";
 
 // The options both entry points share, in one place; `names`: every option
 // the entry point takes, for the message about an unknown one.
@@ -59,6 +59,8 @@ void set_common(TextureOptimizationOptions& o, const py::kwargs& kw, const std::
     else if (k == "histogram_values") o.histogram_values = real_arg(v, k, 0.0, 100.0, Ends::Closed, "0 = off");
     else if (k == "histogram_value_rounds") o.histogram_value_rounds = int_arg(v, k, 1, 64);
     else if (k == "histogram_value_window") o.histogram_value_window = real_arg(v, k, 0.0, 1.0);
+    else if (k == "structure_sigma")
+      o.structure_sigma = real_arg(v, k, 0.0, kMaxStructureSigma, Ends::Closed, "voxels; 0 = off");
     else if (k == "feature_weight") o.feature_weight = real_arg(v, k, 0.0, 100.0, Ends::Closed, "0 = off");
     else if (k == "feature_threshold")
       o.feature_threshold = real_arg(v, k, 0.0, kMaxFeatureThreshold, Ends::Closed, "0 = darker than the window's mean at all");
@@ -189,6 +191,8 @@ void bind_solid(py::module_& m) {
   m.attr("SOLID_DEFAULT_FEATURE_WEIGHT") = SolidOptions{}.feature_weight;
   m.attr("SOLID_DEFAULT_HISTOGRAM_VALUES") = SolidOptions{}.histogram_values;
   m.attr("SOLID_DEFAULT_FEATURE_THRESHOLD") = SolidOptions{}.feature_threshold;
+  m.attr("SOLID_DEFAULT_STRUCTURE_SIGMA") = SolidOptions{}.structure_sigma;
+  m.attr("SOLID_MAX_STRUCTURE_SIGMA") = kMaxStructureSigma;
   m.attr("SOLID_MAX_FEATURE_THRESHOLD") = kMaxFeatureThreshold;
   m.attr("SOLID_DEFAULT_ROTATE_EXEMPLAR") = rotate_exemplar_name(SolidOptions{}.rotate_exemplar);
   m.attr("ROTATE_EXEMPLAR_CHOICES") = py::tuple(py::cast(rotate_exemplar_names()));
@@ -262,7 +266,9 @@ search='kcoherence'|'kdtree'|'exact', coherence_k=4, random_candidates=2, ann_ep
 mean_shift=False, coherent_upsampling=True, exemplar_values=True, histogram_values=SOLID_DEFAULT_HISTOGRAM_VALUES (> 0: the
 exemplar values match the exemplars' histogram, this being the step of the per-bin prices; 0 = off), histogram_value_rounds=32
 (its pricing rounds), histogram_value_window=0 (0..1: the share of a proposal's price taken from its whole
-window's texels, for coherent choices), feature_weight=SOLID_DEFAULT_FEATURE_WEIGHT (the feature-distance channel's weight; 0 = off),
+window's texels, for coherent choices), structure_sigma=SOLID_DEFAULT_STRUCTURE_SIGMA (> 0, with exemplar_values: low
+frequencies below a Gaussian of this many voxels from the optimiser's weighted mean, the rest from the exemplar values,
+then each channel's histogram matched to the exemplars'; 0 = off; up to SOLID_MAX_STRUCTURE_SIGMA), feature_weight=SOLID_DEFAULT_FEATURE_WEIGHT (the feature-distance channel's weight; 0 = off),
 feature_threshold=SOLID_DEFAULT_FEATURE_THRESHOLD (features: pixels darker than their window's mean by more than this x the
 exemplar's luminance std), rotate_exemplar=SOLID_DEFAULT_ROTATE_EXEMPLAR ('on': also the exemplar's 90/180/270-degree
 turns, for textures with no preferred direction: cracks, cells; 'auto': when exemplar_feature_stretch(exemplar) <

@@ -118,6 +118,9 @@ constexpr int kMaxTurnedTile = 128;
 /// Solids' rotate_exemplar (SolidOptions).
 constexpr RotateExemplar kSolidRotateExemplar = RotateExemplar::Auto;
 
+/// Upper end of TextureOptimizationOptions::structure_sigma, in voxels.
+constexpr double kMaxStructureSigma = 8.0;
+
 /// Bins per value channel of TextureOptimizationOptions::histogram_values
 /// (the quality measure's hist_emd uses 32 over the 8-bit range).
 constexpr int kValueBins = 32;
@@ -181,6 +184,15 @@ struct TextureOptimizationOptions {
   /// (each voxel on its own: speckle); towards 1 a window's voxels move
   /// together, so the choices stay coherent pieces of exemplar.
   double histogram_value_window = 0.0;
+  /// sigma > 0 (with exemplar_values): the finest level's last optimisation
+  /// also runs, and the output takes its low frequencies from that weighted
+  /// mean and its high ones from the exemplar values, G(mean) + values -
+  /// G(values) with G a Gaussian of sigma voxels (pixels), then each value
+  /// channel's histogram matched to the exemplars' (solid/structure_detail.hpp):
+  /// the mean has the cells and cracks where the exemplar values blur their
+  /// outlines into the grain. 0 = off (images' default); solids default to
+  /// kSolidStructureSigma. Up to kMaxStructureSigma.
+  double structure_sigma = 0.0;
   /// > 0: add the feature-distance channel (signed distance to the edges of
   /// the exemplar's dark features) with this weight relative to colours in
   /// [0, 1]; it guides matching and is dropped from the output. 0 = off

@@ -64,6 +64,9 @@ class LevelSolver {
     return std::min(voxels, double(kValueSample)) * (3.0 * per_view * sizeof(Proposal) + sizeof(std::uint32_t));
   }
 
+  /// The level's texture (the solver writes it in place).
+  const Volume& texture() const { return tex_; }
+
   /// Units of progress each phase reports (for StageProgress totals).
   std::size_t search_units() const;
   std::size_t optimize_units() const;

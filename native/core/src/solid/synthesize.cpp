@@ -17,6 +17,7 @@
 #include "solid/exemplar_rotations.hpp"
 #include "solid/feature_channel.hpp"
 #include "solid/level_solver.hpp"
+#include "solid/structure_detail.hpp"
 
 namespace exsynth {
 namespace {
@@ -47,6 +48,7 @@ void check_options(const TextureOptimizationOptions& o) {
   range("histogram_values", o.histogram_values, 0, 100, " (0 = off)");
   range("histogram_value_rounds", o.histogram_value_rounds, 1, 64, "");
   range("histogram_value_window", o.histogram_value_window, 0, 1, " (0 = each texel's own price)");
+  range("structure_sigma", o.structure_sigma, 0, kMaxStructureSigma, " voxels (0 = off)");
   if (o.max_exemplar_size != 0) range("max_exemplar_size", o.max_exemplar_size, o.neighborhood, 1 << 16, " pixels (0 = full resolution)");
 }
 
@@ -249,6 +251,8 @@ void check_texture_memory(const Job& job, const TextureOptimizationOptions& opt,
   if (opt.exemplar_values) texture_bytes += voxels * 4.0;  // TextureResult::source
   if (opt.exemplar_values && opt.histogram_values > 0)  // the plain choices (write_values), the rounds' proposals
     texture_bytes += voxels * 4.0 + solid::LevelSolver::sample_proposal_bytes(voxels, n);
+  if (opt.exemplar_values && opt.structure_sigma > 0)  // the mean, the blurred values, one channel's sort
+    texture_bytes += voxels * (channels * 4.0 * 2.0 + 8.0);
   if (p.constraint && !p.constraint->empty()) texture_bytes += voxels * (p.user_channels + 1) * 4.0 * 8.0 / 7.0;
   double exemplar_bytes = 0;
   const Image* largest = p.images[0];
@@ -305,8 +309,12 @@ Volume random_texels(const Dims& d, const std::array<const solid::ExemplarIndex*
 
 // One level's rounds of search and optimisation (and the exemplar-values
 // pass at the finest level), energies appended to `result`.
+// `mean`, when given at the finest level with exemplar values, receives the
+// texture after the last optimisation (the weighted mean), before the
+// exemplar values replace it (structure_sigma).
 void optimize_level(solid::LevelSolver& solver, const Job& job, const TextureOptimizationOptions& opt, const Dims& d,
-                    int l, double energy_scale, double p0, double p1, ExecContext* ctx, TextureResult& result) {
+                    int l, double energy_scale, double p0, double p1, ExecContext* ctx, TextureResult& result,
+                    Volume* mean = nullptr) {
   const int L = opt.levels;
   const std::string stage = job.name + ": level " + std::to_string(l + 1) + "/" + std::to_string(L);
   const bool coarsest = l == 0, finest = l == L - 1;
@@ -314,12 +322,13 @@ void optimize_level(solid::LevelSolver& solver, const Job& job, const TextureOpt
   // the coarsest, which needs its 2x to converge).
   const int iterations = coarsest ? 2 * opt.iterations : finest ? finest_rounds(opt, d) : opt.iterations;
   const bool exemplar_values = finest && opt.exemplar_values;
+  const bool keep_mean = exemplar_values && mean;
   // With exemplar values the finest level's last optimisation would be
   // overwritten voxel for voxel: the pass reads only the matches and
   // weights of the last search, and a voxel it leaves (no covering window)
   // is one the optimisation leaves too. So it is skipped (same output;
-  // measured 2.1 s of 28.6 s CPU at 128^3).
-  const int optimisations = exemplar_values ? iterations - 1 : iterations;
+  // measured 2.1 s of 28.6 s CPU at 128^3) unless its mean is kept.
+  const int optimisations = exemplar_values && !keep_mean ? iterations - 1 : iterations;
   StageProgress progress(ctx, stage, p0 + 0.1 * (p1 - p0), p1,
                          std::size_t(iterations) * solver.search_units() +
                              std::size_t(optimisations) * solver.optimize_units() +
@@ -350,6 +359,7 @@ void optimize_level(solid::LevelSolver& solver, const Job& job, const TextureOpt
   // mean of disagreeing windows is what blurs; the output takes the texels
   // of the best-matching windows instead.
   if (exemplar_values) {
+    if (keep_mean) *mean = solver.texture();
     if (ctx) ctx->set_stage(stage + " exemplar values");
     solver.discrete(progress, &result.source);
   }
@@ -406,6 +416,8 @@ TextureResult optimize_texture(const Job& job, const TextureOptimizationOptions&
   std::unique_ptr<solid::LevelSolver> previous;
   std::vector<std::unique_ptr<solid::ExemplarIndex>> prev_index;
   const Volume empty;
+  const bool split = opt.exemplar_values && opt.structure_sigma > 0;
+  Volume mean;  // the finest level's weighted mean (structure_sigma)
   for (int l = 0; l < L; ++l) {
     const double p0 = done / total_work, p1 = (done + double(dims[l].voxels())) / total_work;
     done += double(dims[l].voxels());
@@ -431,9 +443,16 @@ TextureResult optimize_texture(const Job& job, const TextureOptimizationOptions&
     auto solver = std::make_unique<solid::LevelSolver>(tex, views, constraint, opt, wrap,
                                                        hash_index(opt.seed, std::uint64_t(l), 0x5EED), lo, hi);
     if (l > 0) solver->inherit_matches(*previous);
-    optimize_level(*solver, job, opt, d, l, energy_scale, p0, p1, ctx, result);
+    optimize_level(*solver, job, opt, d, l, energy_scale, p0, p1, ctx, result, split ? &mean : nullptr);
     previous = std::move(solver);
     prev_index = std::move(index);  // the solver's views point into these
+  }
+  if (split) {
+    // (the finest level's progress ends at 1; the split is short: ~0.3 s at 128^3)
+    StageProgress progress(ctx, job.name + ": structure and detail", 1.0, 1.0,
+                           solid::split_units(tex, ex.user_channels));
+    solid::split_structure_detail(tex, std::move(mean), opt.structure_sigma, wrap ? Boundary::Wrap : Boundary::Clamp,
+                                  ex.user_channels, ex.images, progress);
   }
   if (ctx) ctx->set_progress(1.0);
   if (channels != ex.user_channels) {  // drop the feature-distance channel
