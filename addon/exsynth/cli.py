@@ -191,6 +191,10 @@ def _parser():
     p.add_argument("--histogram-values", type=_finite, default=_native.SOLID_DEFAULT_HISTOGRAM_VALUES,
                    help="with --method optimization: how strongly each voxel's exemplar colour is picked to match "
                    "the exemplar's histogram (contrast); above 0.5 it oscillates, 0 = off (default %(default)s)")
+    p.add_argument("--structure-sigma", type=_finite, default=_native.SOLID_DEFAULT_STRUCTURE_SIGMA,
+                   help="with --method optimization: shapes larger than this many voxels (cells, stones) come from "
+                   "the optimiser's average, finer grain from the exemplar's colours, then matched to the exemplar's "
+                   "histogram; 0 = off (default %(default)s)")
     p.add_argument("--seed", type=_seed, default=0, help="random seed (default 0)")
     p.add_argument("--alpha", action="store_true", help="synthesize the exemplars' alpha as a 4th channel")
     p.add_argument("--scale", type=_finite, default=0.0,
@@ -524,6 +528,9 @@ def _run_solid(args):
              f"(got {args.feature_threshold}); 0 = any darker pixel is a feature")
     _require(args.histogram_values >= 0,
              f"--histogram-values must be >= 0 (got {args.histogram_values}); 0 = off")
+    _require(0 <= args.structure_sigma <= _native.SOLID_MAX_STRUCTURE_SIGMA,
+             f"--structure-sigma must be in 0..{_native.SOLID_MAX_STRUCTURE_SIGMA:g} voxels "
+             f"(got {args.structure_sigma}); 0 = off")
     _require(args.scale >= 0, f"--scale must be >= 0 (got {args.scale}); 0 picks it from the mesh")
     _require(args.memory_budget >= 0, f"--memory-budget must be >= 0 GiB (got {args.memory_budget})")
     _require(bool(args.mesh) == bool(args.bake_out), "--mesh and --bake-out go together")
@@ -547,7 +554,7 @@ def _run_solid(args):
         exemplar_z=exemplar_z, size=args.size, levels=args.levels, iterations=args.iterations,
         method=args.method, feature_weight=args.feature_weight, feature_threshold=args.feature_threshold,
         rotate_exemplar=args.rotate_exemplar, histogram_values=args.histogram_values,
-        scale=scale, seed=args.seed,
+        structure_sigma=args.structure_sigma, scale=scale, seed=args.seed,
         memory_budget=int(args.memory_budget * GIB), encoding=encoding,
         anchor=anchor, targets=targets, bake=solid_ops.BakeOptions(args.bake_size, args.bake_interpolation),
     )

@@ -182,6 +182,15 @@ class ExSynthSettings(bpy.types.PropertyGroup):
         "Coordinates method ignores it",
         default=_native.SOLID_DEFAULT_HISTOGRAM_VALUES, min=0.0, max=100.0, soft_max=1.0,
     )
+    solid_structure_sigma: FloatProperty(
+        name="Structure Blur",
+        description="The Optimization method's split, in voxels: shapes larger than this (cells, stones, cracks' "
+        "outlines) come from the optimiser's smooth average, finer grain from the exemplar's own colours, then "
+        "the colours are matched to the exemplar's. Clearer cells; 0 = exemplar colours only. The Coordinates "
+        "method ignores it",
+        default=_native.SOLID_DEFAULT_STRUCTURE_SIGMA, min=0.0, max=_native.SOLID_MAX_STRUCTURE_SIGMA,
+        soft_max=3.0,
+    )
     solid_scale: FloatProperty(
         name="Scale",
         description="Edge length of one tile of the solid, in the units of the solid's Volume object "

@@ -168,6 +168,7 @@ class SolidJob(Job):
     feature_threshold: float = _native.SOLID_DEFAULT_FEATURE_THRESHOLD  # which dark pixels are features
     rotate_exemplar: str = _native.SOLID_DEFAULT_ROTATE_EXEMPLAR  # its quarter turns: off, on, auto
     histogram_values: float = _native.SOLID_DEFAULT_HISTOGRAM_VALUES  # the optimiser's; 0 = off
+    structure_sigma: float = _native.SOLID_DEFAULT_STRUCTURE_SIGMA  # the optimiser's, in voxels; 0 = off
     scale: float = 1.0              # edge length of one tile
     seed: int = 0
     memory_budget: int = 0          # bytes; 0 = the engine's default
@@ -186,6 +187,7 @@ class SolidJob(Job):
             memory_budget=self.memory_budget, ctx=ctx, method=self.method or _native.SOLID_DEFAULT_METHOD,
             feature_weight=self.feature_weight, feature_threshold=self.feature_threshold,
             rotate_exemplar=self.rotate_exemplar, histogram_values=self.histogram_values,
+            structure_sigma=self.structure_sigma,
         )
         solid = Solid(res["solid"], self.scale / self.size, list(res["energy"]), tuple(res["rotated_exemplar"]))
         baked = bake_targets(solid.values, solid.origin, solid.voxel_size, self.targets, self.bake, ctx,
@@ -375,7 +377,7 @@ class EXSYNTH_OT_solid_texture(JobOperator, bpy.types.Operator):
             levels=settings.solid_levels, iterations=settings.solid_iterations,
             method=settings.solid_method.lower(), feature_weight=settings.solid_feature_weight,
             feature_threshold=settings.solid_feature_threshold, rotate_exemplar=settings.solid_rotate_exemplar.lower(),
-            histogram_values=settings.solid_histogram_values,
+            histogram_values=settings.solid_histogram_values, structure_sigma=settings.solid_structure_sigma,
             scale=settings.solid_scale, seed=settings.seed,
             memory_budget=settings.memory_budget_bytes, encoding=encoding, anchor=anchor,
             targets=targets, bake=bake_options(settings),

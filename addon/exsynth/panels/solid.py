@@ -88,6 +88,7 @@ class EXSYNTH_PT_solid_advanced(SidebarPanel, bpy.types.Panel):
         row.prop(settings, "solid_feature_threshold")
         col.prop(settings, "solid_rotate_exemplar")
         col.prop(settings, "solid_histogram_values")
+        col.prop(settings, "solid_structure_sigma")
         draw_shared_advanced(layout, context.scene.exsynth)
 
 

@@ -66,6 +66,14 @@ class LevelSolver {
 
   /// The level's texture (the solver writes it in place).
   const Volume& texture() const { return tex_; }
+  /// Every voxel pulled towards the constraint's targets by its weight, as
+  /// the phases do: after a step that rewrote the texture (structure_sigma).
+  void constrain_texture() {
+    if (constraint_.empty()) return;
+    for (int z = 0; z < tex_.nz(); ++z)
+      for (int y = 0; y < tex_.ny(); ++y)
+        for (int x = 0; x < tex_.nx(); ++x) constrain(x, y, z, &tex_.at(x, y, z));
+  }
 
   /// Units of progress each phase reports (for StageProgress totals).
   std::size_t search_units() const;

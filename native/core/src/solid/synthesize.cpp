@@ -453,6 +453,7 @@ TextureResult optimize_texture(const Job& job, const TextureOptimizationOptions&
                            solid::split_units(tex, ex.user_channels));
     solid::split_structure_detail(tex, std::move(mean), opt.structure_sigma, wrap ? Boundary::Wrap : Boundary::Clamp,
                                   ex.user_channels, ex.images, progress);
+    previous->constrain_texture();  // a requested target still wins by its weight
   }
   if (ctx) ctx->set_progress(1.0);
   if (channels != ex.user_channels) {  // drop the feature-distance channel
