@@ -204,6 +204,15 @@ def test_solid_histogram_values(tmp_path, capsys):
         refuses(tmp_path, capsys, ["--histogram-values", value], message)
 
 
+def test_solid_structure_sigma(tmp_path, capsys):
+    default = _native.SOLID_DEFAULT_STRUCTURE_SIGMA
+    value = 0.0 if default else 1.5  # the flag away from the default reaches the engine
+    solid_as_the_engine_makes(tmp_path, capsys, ["--structure-sigma", str(value)], "structure_sigma", value, default)
+    for bad in ("-1", "9"):
+        refuses(tmp_path, capsys, ["--structure-sigma", bad],
+                f"--structure-sigma must be in 0..8 voxels (got {float(bad)})")
+
+
 @pytest.mark.parametrize("method", ["coordinates", "optimization"])
 def test_run_image_keeps_to_the_memory_budget_with_either_method(tmp_path, capsys, method):
     out = tmp_path / "x.png"

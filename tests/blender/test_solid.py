@@ -700,6 +700,14 @@ def test_histogram_values_default_to_the_engines_and_reach_it(cow, exemplar):
     made_as_the_engine_makes(exemplar, "histogram_values", 0.1, 0.0)
 
 
+def test_structure_sigma_defaults_to_the_engines_and_reaches_it(cow, exemplar):
+    assert settings().solid_structure_sigma == pytest.approx(_native.SOLID_DEFAULT_STRUCTURE_SIGMA)
+    default = _native.SOLID_DEFAULT_STRUCTURE_SIGMA
+    value = 0.0 if default else 1.5  # the setting away from the default reaches the engine
+    settings().solid_structure_sigma = value
+    made_as_the_engine_makes(exemplar, "structure_sigma", value, default or 0.0)
+
+
 # ---- feature weight (the optimiser's feature-distance channel) --------------------------------
 def test_feature_weight_defaults_to_the_engines_and_reaches_it(cow, exemplar):
     assert settings().solid_feature_weight == pytest.approx(_native.SOLID_DEFAULT_FEATURE_WEIGHT)

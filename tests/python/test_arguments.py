@@ -72,7 +72,7 @@ FUNCTIONS = {
         "feature_weight": ("real", 0, 100),
         "feature_threshold": ("real", 0, 10), "rotate_exemplar": "str",
         "exemplar_values": "bool", "histogram_values": ("real", 0, 100), "histogram_value_rounds": ("int", 1, 64),
-        "histogram_value_window": ("real", 0, 1),
+        "histogram_value_window": ("real", 0, 1), "structure_sigma": ("real", 0, 8),
         "tileable": "bool", "memory_budget": "budget", "seed": "seed", "ctx": "ctx",
         "method": "str", "coordinate_coherence_k": ("int", 0, 16)}),
     "synthesize_image": (call("synthesize_image", IMG, width=8, height=8, levels=1, iterations=1), {

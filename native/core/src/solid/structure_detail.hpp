@@ -29,8 +29,8 @@ std::size_t blur_units(const Volume& v);
 /// and deterministic; one unit of progress per channel.
 void match_histograms(Volume& v, int channels, const std::vector<const Image*>& images, StageProgress& progress);
 
-/// values <- G(mean) + values - G(values), then match_histograms. `mean` is
-/// consumed (blurred in place). Units: split_units.
+/// values <- G(mean) + values - G(values), computed as values + G(mean -
+/// values), then match_histograms. `mean` is consumed. Units: split_units.
 void split_structure_detail(Volume& values, Volume&& mean, double sigma, Boundary boundary, int channels,
                             const std::vector<const Image*>& images, StageProgress& progress);
 std::size_t split_units(const Volume& v, int channels);

@@ -251,8 +251,8 @@ void check_texture_memory(const Job& job, const TextureOptimizationOptions& opt,
   if (opt.exemplar_values) texture_bytes += voxels * 4.0;  // TextureResult::source
   if (opt.exemplar_values && opt.histogram_values > 0)  // the plain choices (write_values), the rounds' proposals
     texture_bytes += voxels * 4.0 + solid::LevelSolver::sample_proposal_bytes(voxels, n);
-  if (opt.exemplar_values && opt.structure_sigma > 0)  // the mean, the blurred values, one channel's sort
-    texture_bytes += voxels * (channels * 4.0 * 2.0 + 8.0);
+  if (opt.exemplar_values && opt.structure_sigma > 0)  // the mean, one channel's sort
+    texture_bytes += voxels * (channels * 4.0 + 8.0);
   if (p.constraint && !p.constraint->empty()) texture_bytes += voxels * (p.user_channels + 1) * 4.0 * 8.0 / 7.0;
   double exemplar_bytes = 0;
   const Image* largest = p.images[0];
