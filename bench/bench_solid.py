@@ -8,7 +8,7 @@ so speed and quality are read together. The coordinates rows' energy is
 another unit (the last correction pass's mean crossbar cost in appearance
 space); "cpu s" is the whole process's user+sys.
 
-usage: bench_solid.py --build BUILD_DIR [--cases solid128,solid128_unturned,solid128_t0,solid128_brick,solid256,image256,coord64,coord128]
+usage: bench_solid.py --build BUILD_DIR [--cases solid128,solid128_unturned,solid128_t0,solid128_brick,solid128_split,solid256,image256,coord64,coord128]
 """
 import argparse
 import json
@@ -35,13 +35,16 @@ CASES = {
     # analysis runs on its four quarter turns, 4x the windows. Unturned, for the cost of the turns:
     "solid128_unturned": ("solid 128^3 RGB, unturned",
                           "res = _native.synthesize_solid(ex, size=128, levels=3, seed=1, rotate_exemplar='off')"),
+    # structure_sigma (docs/solid.md, eighteenth pass): the finest level's mean as well, the split, the match
+    "solid128_split": ("solid 128^3 RGB, structure_sigma 1.5",
+                       "res = _native.synthesize_solid(ex, size=128, levels=3, seed=1, structure_sigma=1.5)"),
     "solid256": ("solid 256^3 RGB, 3 levels", "res = _native.synthesize_solid(ex, size=256, levels=3, seed=1)"),
     "image256": ("image 128^2 -> 256^2, 3 levels", "res = _native.synthesize_image(ex, width=256, height=256, seed=1)"),
     # method="coordinates" (exemplar coordinates; the solid rows above use the default method)
     "coord64": ("solid 64^3 RGB, coordinates", "res = _native.synthesize_solid(ex, size=64, seed=1, method='coordinates')"),
     "coord128": ("solid 128^3 RGB, coordinates", "res = _native.synthesize_solid(ex, size=128, seed=1, method='coordinates')"),
 }
-DEFAULT_CASES = "solid128,solid128_unturned,solid128_t0,solid128_brick,solid256,image256"
+DEFAULT_CASES = "solid128,solid128_unturned,solid128_t0,solid128_brick,solid128_split,solid256,image256"
 
 
 CHILD = """
