@@ -881,18 +881,8 @@ TEST(Solid, HistogramValuesCancel) {
 TEST(Solid, HistogramValuesRespectTheConstraint) {
   const Image ex = contrasty_exemplar();
   SolidOptions o = histogram_values_options();
-  SolidExemplars constrained = one_exemplar(ex);
-  constrained.constraint = Volume(o.size, o.size, o.size, 4, 0.0f);
   const float target[3] = {0.9f, 0.1f, 0.4f};
-  auto pinned = [](int x, int y, int z) { return x < 6 && y < 6 && z < 6; };
-  for (int z = 0; z < o.size; ++z)
-    for (int y = 0; y < o.size; ++y)
-      for (int x = 0; x < o.size; ++x)
-        if (pinned(x, y, z)) {
-          for (int c = 0; c < 3; ++c) constrained.constraint.at(x, y, z, c) = target[c];
-          constrained.constraint.at(x, y, z, 3) = 1.0f;
-        }
-  const TextureResult r = synthesize_solid(constrained, o);
+  const TextureResult r = synthesize_solid(exsynth::testing::pinned_corner(ex, o.size, 6, target), o);
   for (int z = 0; z < 6; ++z)
     for (int y = 0; y < 6; ++y)
       for (int x = 0; x < 6; ++x)

@@ -157,16 +157,8 @@ TEST(StructureDetail, CancelInsideTheSplit) {
 TEST(StructureDetail, TheConstraintStillWins) {
   const Image ex = disc_texture(32, 32, 3, 23);
   const SolidOptions o = split_options();
-  SolidExemplars constrained = one_exemplar(ex);
-  constrained.constraint = Volume(o.size, o.size, o.size, 4, 0.0f);
   const float target[3] = {0.9f, 0.1f, 0.4f};
-  for (int z = 0; z < 5; ++z)
-    for (int y = 0; y < 5; ++y)
-      for (int x = 0; x < 5; ++x) {
-        for (int c = 0; c < 3; ++c) constrained.constraint.at(x, y, z, c) = target[c];
-        constrained.constraint.at(x, y, z, 3) = 1.0f;
-      }
-  const Volume r = synthesize_solid(constrained, o).texture;
+  const Volume r = synthesize_solid(exsynth::testing::pinned_corner(ex, o.size, 5, target), o).texture;
   for (int z = 0; z < 5; ++z)
     for (int y = 0; y < 5; ++y)
       for (int x = 0; x < 5; ++x)

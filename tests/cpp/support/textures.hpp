@@ -43,4 +43,19 @@ inline SolidExemplars one_exemplar(const Image& img) {
   return ex;
 }
 
+/// `img` as every view of a size^3 solid whose constraint pins the corner
+/// cube [0, edge)^3 to the C values `target` (weight 1) and leaves the rest free.
+inline SolidExemplars pinned_corner(const Image& img, int size, int edge, const float* target) {
+  SolidExemplars ex = one_exemplar(img);
+  const int C = img.channels();
+  ex.constraint = Volume(size, size, size, C + 1, 0.0f);
+  for (int z = 0; z < edge; ++z)
+    for (int y = 0; y < edge; ++y)
+      for (int x = 0; x < edge; ++x) {
+        for (int c = 0; c < C; ++c) ex.constraint.at(x, y, z, c) = target[c];
+        ex.constraint.at(x, y, z, C) = 1.0f;
+      }
+  return ex;
+}
+
 }  // namespace exsynth::testing

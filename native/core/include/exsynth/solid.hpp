@@ -190,8 +190,9 @@ struct TextureOptimizationOptions {
   /// G(values) with G a Gaussian of sigma voxels (pixels), then each value
   /// channel's histogram matched to the exemplars' (solid/structure_detail.hpp):
   /// the mean has the cells and cracks where the exemplar values blur their
-  /// outlines into the grain. 0 = off (images' default); solids default to
-  /// kSolidStructureSigma. Up to kMaxStructureSigma.
+  /// outlines into the grain. 0 = off, the default for solids and images
+  /// alike (mixed on the 8 bench exemplars: docs/solid.md, eighteenth pass).
+  /// Up to kMaxStructureSigma.
   double structure_sigma = 0.0;
   /// > 0: add the feature-distance channel (signed distance to the edges of
   /// the exemplar's dark features) with this weight relative to colours in
