@@ -102,21 +102,23 @@ def whole_process(cmd, env=None):
     return wall, (r1.ru_utime - r0.ru_utime) + (r1.ru_stime - r0.ru_stime)
 
 
-CALIBRATION_WIDTHS = (9, 9, 7, 9, 7)  # held-out, exsynth (copy), gmic (copy)
+CALIBRATION_WIDTHS = (9, 9, 7, 9, 9, 7)  # held-out, exsynth (copy), solid, gmic (copy)
 
 
-def calibration(names, quality, native, image_opts, peers, tmp):
+def calibration(names, quality, native, opts, image_opts, peers, tmp):
     """nn_rel of an unseen piece of each texture, beside syntheses from the rest.
 
     The exemplar's left half (128 x 64) is the exemplar here; its right half,
     never seen by anyone, scores what the texture itself scores; exsynth and
-    G'MIC make 128^2 from the left half. A synthesis far below the held-out
-    score is closer to a copy than the texture is to itself.
+    G'MIC make 128^2 from the left half, and exsynth a 64^3 solid (its
+    slices, as in the main table). A synthesis far below the held-out score
+    is closer to a copy than the texture is to itself.
     """
     print()
     print("calibration of nn_rel: left half (128 x 64) as exemplar; its right half (the texture itself, unseen) "
-          "against syntheses 128^2 from the left half")
-    head = f"{'exemplar':<16} {'held-out':>9} {'exsynth':>9} {'(copy)':>7}" + (f" {'gmic':>9} {'(copy)':>7}" if peers else "")
+          "against syntheses from the left half: images 128^2, a solid 64^3 (mean of x/y/z slices)")
+    head = (f"{'exemplar':<16} {'held-out':>9} {'exsynth':>9} {'(copy)':>7} {'solid':>9}" +
+            (f" {'gmic':>9} {'(copy)':>7}" if peers else ""))
     print(head)
     print("-" * len(head))
     sums = []
@@ -126,7 +128,9 @@ def calibration(names, quality, native, image_opts, peers, tmp):
         E = quality.Exemplar(left)
         held = quality.image_metrics(E, right)
         ours = quality.image_metrics(E, native.synthesize_image(left, width=128, height=128, seed=7, **image_opts)["image"])
-        vals = [held["nn_rel"], ours["nn_rel"], ours["copy_rate"]]
+        solid = native.synthesize_solid(left, size=64, seed=7, **opts)["solid"]
+        vals = [held["nn_rel"], ours["nn_rel"], ours["copy_rate"],
+                quality.volume_metrics(E, solid, slices=8)["mean"]["nn_rel"]]
         if peers:
             png = os.path.join(tmp, name + "_left.png")
             Image.fromarray(left).save(png)
@@ -237,7 +241,7 @@ def main(argv=None):
     if args.solids_only:
         return 0
     if not args.no_calibration:
-        calibration(names, quality, _native, image_opts, peers, tmp)
+        calibration(names, quality, _native, opts, image_opts, peers, tmp)
     print()
     print("speed (whole process, same run, alternating; median of 3)")
     env = dict(os.environ, PYTHONPATH=os.path.join(args.build, "addon"))
