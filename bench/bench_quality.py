@@ -20,9 +20,9 @@ Exemplar sources: assets/textures (bundled), the Debian packages gimp-data
 (/usr/share/gimp/2.0/patterns) and assimp-testmodels (/usr/share/assimp).
 
 Then a calibration of nn_rel ("the texture itself"): each exemplar's right
-half scored against its left half, beside a synthesis (and G'MIC's) from that
-left half: an unseen piece of the same texture is the score a synthesis that
-does not copy can hope for.
+half scored against its left half, beside syntheses from that left half (a
+128^2 image, G'MIC's, a 64^3 solid): an unseen piece of the same texture is
+the score a synthesis that does not copy can hope for.
 
 usage: bench_quality.py --build BUILD_DIR [--full] [--exemplars a,b] [--no-peers] [--no-calibration]
                        [--options 'k=v, ...'] [--image-options 'k=v, ...']
