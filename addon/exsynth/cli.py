@@ -182,6 +182,10 @@ def _parser():
                    help="with --method optimization: which exemplar pixels are features, in luminance standard "
                    "deviations below their window's mean; 0 = any darker pixel (softer cells), 1 = only deep cracks and "
                    "mortar (crisper; round cells need --rotate-exemplar auto or on) (default %(default)s)")
+    p.add_argument("--feature-scale", type=int, default=_native.SOLID_DEFAULT_FEATURE_SCALE,
+                   help="with --method optimization: exemplar pixels from a feature's edge at which its distance "
+                   "stops growing; larger keeps round stones whole (crackedground: 16) but can line other textures "
+                   "up as sheets; 0 = the neighbourhood's size (default %(default)s)")
     p.add_argument("--rotate-exemplar", choices=_native.ROTATE_EXEMPLAR_CHOICES, nargs="?",
                    const="on", default=_native.SOLID_DEFAULT_ROTATE_EXEMPLAR,
                    help="with --method optimization: also match the exemplar turned by 90, 180 and 270 degrees, "
@@ -526,6 +530,9 @@ def _run_solid(args):
     _require(0 <= args.feature_threshold <= _native.SOLID_MAX_FEATURE_THRESHOLD,
              f"--feature-threshold must be in 0..{_native.SOLID_MAX_FEATURE_THRESHOLD:g} "
              f"(got {args.feature_threshold}); 0 = any darker pixel is a feature")
+    _require(0 <= args.feature_scale <= _native.SOLID_MAX_FEATURE_SCALE,
+             f"--feature-scale must be in 0..{_native.SOLID_MAX_FEATURE_SCALE} exemplar pixels "
+             f"(got {args.feature_scale}); 0 = the neighbourhood's size")
     _require(args.histogram_values >= 0,
              f"--histogram-values must be >= 0 (got {args.histogram_values}); 0 = off")
     _require(0 <= args.structure_sigma <= _native.SOLID_MAX_STRUCTURE_SIGMA,
@@ -553,7 +560,7 @@ def _run_solid(args):
         name=solid_ops.exemplar_name(images[0]), exemplar=exemplar, exemplar_y=exemplar_y,
         exemplar_z=exemplar_z, size=args.size, levels=args.levels, iterations=args.iterations,
         method=args.method, feature_weight=args.feature_weight, feature_threshold=args.feature_threshold,
-        rotate_exemplar=args.rotate_exemplar, histogram_values=args.histogram_values,
+        feature_scale=args.feature_scale, rotate_exemplar=args.rotate_exemplar, histogram_values=args.histogram_values,
         structure_sigma=args.structure_sigma, scale=scale, seed=args.seed,
         memory_budget=int(args.memory_budget * GIB), encoding=encoding,
         anchor=anchor, targets=targets, bake=solid_ops.BakeOptions(args.bake_size, args.bake_interpolation),

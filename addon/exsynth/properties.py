@@ -166,6 +166,14 @@ class ExSynthSettings(bpy.types.PropertyGroup):
         default=_native.SOLID_DEFAULT_FEATURE_THRESHOLD, min=0.0, max=_native.SOLID_MAX_FEATURE_THRESHOLD,
         soft_max=2.0,
     )
+    solid_feature_scale: IntProperty(
+        name="Feature Scale",
+        description="How far into a stone or cell, in exemplar pixels, the Optimization method's feature "
+        "distance still grows: larger tells a stone's middle from its rim and keeps round stones whole "
+        "(crackedground at 16), but can line other textures up as sheets; 0 = the neighbourhood's size (8). "
+        "The Coordinates method ignores it",
+        default=_native.SOLID_DEFAULT_FEATURE_SCALE, min=0, max=_native.SOLID_MAX_FEATURE_SCALE, soft_max=32,
+    )
     solid_rotate_exemplar: EnumProperty(
         name="Rotate Exemplar",
         description="Also match the exemplar turned by 90, 180 and 270 degrees, for textures with no preferred "

@@ -30,7 +30,7 @@ RotateExemplar rotate_arg(const py::handle& v, const std::string& k) {
 constexpr const char* kCommonNames =
     "levels, neighborhood, iterations, finest_iterations, r, pca_variance, max_pca_dims, search, coherence_k, "
     "random_candidates, ann_eps, histogram_matching, histogram_bins, histogram_strength, mean_shift, "
-    "coherent_upsampling, exemplar_values, histogram_values, histogram_value_rounds, histogram_value_window, structure_sigma, feature_weight, feature_threshold, rotate_exemplar, tileable, max_exemplar_size, memory_budget, seed";
+    "coherent_upsampling, exemplar_values, histogram_values, histogram_value_rounds, histogram_value_window, structure_sigma, feature_weight, feature_threshold, feature_scale, rotate_exemplar, tileable, max_exemplar_size, memory_budget, seed";
 
 // The options both entry points share, in one place; `names`: every option
 // the entry point takes, for the message about an unknown one.
@@ -64,6 +64,8 @@ void set_common(TextureOptimizationOptions& o, const py::kwargs& kw, const std::
     else if (k == "feature_weight") o.feature_weight = real_arg(v, k, 0.0, 100.0, Ends::Closed, "0 = off");
     else if (k == "feature_threshold")
       o.feature_threshold = real_arg(v, k, 0.0, kMaxFeatureThreshold, Ends::Closed, "0 = darker than the window's mean at all");
+    else if (k == "feature_scale")
+      o.feature_scale = int_arg(v, k, 0, kMaxFeatureScale, "exemplar pixels; 0 = the neighbourhood's edge");
     else if (k == "rotate_exemplar") o.rotate_exemplar = rotate_arg(v, k);
     else if (k == "tileable") o.tileable = bool_arg(v, k);
     else if (k == "max_exemplar_size") o.max_exemplar_size = int_arg(v, k, 0, 1 << 16);
@@ -194,6 +196,8 @@ void bind_solid(py::module_& m) {
   m.attr("SOLID_DEFAULT_STRUCTURE_SIGMA") = SolidOptions{}.structure_sigma;
   m.attr("SOLID_MAX_STRUCTURE_SIGMA") = kMaxStructureSigma;
   m.attr("SOLID_MAX_FEATURE_THRESHOLD") = kMaxFeatureThreshold;
+  m.attr("SOLID_DEFAULT_FEATURE_SCALE") = SolidOptions{}.feature_scale;
+  m.attr("SOLID_MAX_FEATURE_SCALE") = kMaxFeatureScale;
   m.attr("SOLID_DEFAULT_ROTATE_EXEMPLAR") = rotate_exemplar_name(SolidOptions{}.rotate_exemplar);
   m.attr("ROTATE_EXEMPLAR_CHOICES") = py::tuple(py::cast(rotate_exemplar_names()));
   m.attr("ROUND_FEATURE_STRETCH") = kRoundFeatureStretch;
@@ -270,13 +274,14 @@ window's texels, for coherent choices), structure_sigma=SOLID_DEFAULT_STRUCTURE_
 frequencies below a Gaussian of this many voxels from the optimiser's weighted mean, the rest from the exemplar values,
 then each channel's histogram matched to the exemplars'; 0 = off; up to SOLID_MAX_STRUCTURE_SIGMA), feature_weight=SOLID_DEFAULT_FEATURE_WEIGHT (the feature-distance channel's weight; 0 = off),
 feature_threshold=SOLID_DEFAULT_FEATURE_THRESHOLD (features: pixels darker than their window's mean by more than this x the
-exemplar's luminance std), rotate_exemplar=SOLID_DEFAULT_ROTATE_EXEMPLAR ('on': also the exemplar's 90/180/270-degree
+exemplar's luminance std), feature_scale=SOLID_DEFAULT_FEATURE_SCALE (the channel's distance saturates this many exemplar
+pixels from a feature's edge; 0 = neighborhood; up to SOLID_MAX_FEATURE_SCALE), rotate_exemplar=SOLID_DEFAULT_ROTATE_EXEMPLAR ('on': also the exemplar's 90/180/270-degree
 turns, for textures with no preferred direction: cracks, cells; 'auto': when exemplar_feature_stretch(exemplar) <
 ROUND_FEATURE_STRETCH; 'off'; True / False = 'on' / 'off'), tileable=True,
 max_exemplar_size=256 (working resolution: larger exemplars are halved until they fit; 0 = never),
 method=SOLID_DEFAULT_METHOD ('optimization': Kopf et al. 2007; 'coordinates': exemplar coordinates after
 Dong et al. 2008, which uses levels, iterations, finest_iterations, coordinate_coherence_k=0 (0..16), pca_variance, max_pca_dims,
-max_exemplar_size, tileable, memory_budget and seed (feature_weight, feature_threshold, rotate_exemplar and histogram_values
+max_exemplar_size, tileable, memory_budget and seed (feature_weight, feature_threshold, feature_scale, rotate_exemplar and histogram_values
 do not apply), and takes no constraint),
 memory_budget=0 (default), seed=0. size: min_texture_size(levels, neighborhood) .. SOLID_MAX_SIZE.
 Returns {'solid': (Z, Y, X, C) float32, 'energy': [...], 'energy_level': [...], 'rotated_exemplar': (x, y, z)

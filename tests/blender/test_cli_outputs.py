@@ -191,6 +191,14 @@ def test_solid_feature_threshold(tmp_path, capsys):
                 f"--feature-threshold must be in 0..10 (got {float(value)})")
 
 
+def test_solid_feature_scale(tmp_path, capsys):
+    solid_as_the_engine_makes(tmp_path, capsys, ["--feature-scale", "16"], "feature_scale", 16, 0)
+    for value in ("-1", "65"):
+        refuses(tmp_path, capsys, ["--feature-scale", value],
+                f"--feature-scale must be in 0..64 exemplar pixels (got {value})")
+    refuses(tmp_path, capsys, ["--feature-scale", "2.5"], "invalid int value: '2.5'", code=2)
+
+
 def test_solid_rotate_exemplar(tmp_path, capsys):
     # The flag alone turns the exemplar; auto (the default) and off by name.
     solid_as_the_engine_makes(tmp_path, capsys, ["--rotate-exemplar"], "rotate_exemplar", "on", "off")

@@ -733,6 +733,14 @@ def test_feature_threshold_defaults_to_the_engines_and_reaches_it(cow, exemplar)
     made_as_the_engine_makes(exemplar, "feature_threshold", 0.0, 1.0)
 
 
+def test_feature_scale_defaults_to_the_engines_and_reaches_it(cow, exemplar):
+    assert settings().solid_feature_scale == _native.SOLID_DEFAULT_FEATURE_SCALE == 0
+    rna = settings().bl_rna.properties["solid_feature_scale"]
+    assert (rna.hard_min, rna.hard_max) == (0, _native.SOLID_MAX_FEATURE_SCALE)
+    settings().solid_feature_scale = 16
+    made_as_the_engine_makes(exemplar, "feature_scale", 16, 0)
+
+
 def test_rotate_exemplar_defaults_to_the_engines_and_reaches_it(cow, exemplar):
     assert settings().solid_rotate_exemplar == _native.SOLID_DEFAULT_ROTATE_EXEMPLAR.upper() == "AUTO"
     items = settings().bl_rna.properties["solid_rotate_exemplar"].enum_items

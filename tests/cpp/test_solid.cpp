@@ -627,6 +627,33 @@ TEST(Solid, FeatureChannelGuidesMatchingAndIsDropped) {
     EXPECT_LT(slice_to_exemplar_distance(r.texture, axis, ex), 0.5 * slice_to_exemplar_distance(baseline, axis, ex));
 }
 
+// feature_scale: 0 is the neighbourhood's edge (the solid made with it and
+// with feature_scale = n is the same, bit for bit), another scale makes
+// another channel and so another solid; out of range it is refused by name.
+TEST(Solid, FeatureScaleZeroIsTheNeighbourhoodAndOthersReachTheChannel) {
+  const Image ex = disc_texture(32, 32, 3, 15);
+  SolidOptions o = small_options();
+  ASSERT_GT(o.feature_weight, 0.0);
+  ASSERT_EQ(o.feature_scale, 0);
+  const TextureResult by_default = synthesize_solid(one_exemplar(ex), o);
+  o.feature_scale = o.neighborhood;
+  const TextureResult at_n = synthesize_solid(one_exemplar(ex), o);
+  EXPECT_EQ(by_default.texture.values(), at_n.texture.values());
+  o.feature_scale = 2 * o.neighborhood;
+  const TextureResult wider = synthesize_solid(one_exemplar(ex), o);
+  EXPECT_NE(by_default.texture.values(), wider.texture.values());
+  EXPECT_EQ(wider.texture.channels(), 3);  // the channel is dropped at any scale
+  for (int bad : {-1, kMaxFeatureScale + 1}) {
+    o.feature_scale = bad;
+    try {
+      synthesize_solid(one_exemplar(ex), o);
+      ADD_FAILURE() << "accepted feature_scale " << bad;
+    } catch (const InvalidInput& e) {
+      EXPECT_THAT(e.what(), HasSubstr("feature_scale must be between 0"));
+    }
+  }
+}
+
 // The feature channel is the solver's, not the caller's: a constraint names
 // the exemplar's channels (C + 1 = target values, weight), its targets win
 // where the weight is 1 and the rest of the solid is synthesized as usual.

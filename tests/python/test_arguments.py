@@ -70,7 +70,7 @@ FUNCTIONS = {
         "random_candidates": ("int", 0, 64), "ann_eps": ("real", 0, 1e6), "histogram_matching": "bool",
         "histogram_bins": ("int", 2, 256), "histogram_strength": ("real", 0, 16), "mean_shift": "bool",
         "feature_weight": ("real", 0, 100),
-        "feature_threshold": ("real", 0, 10), "rotate_exemplar": "str",
+        "feature_threshold": ("real", 0, 10), "feature_scale": ("int", 0, 64), "rotate_exemplar": "str",
         "exemplar_values": "bool", "histogram_values": ("real", 0, 100), "histogram_value_rounds": ("int", 1, 64),
         "histogram_value_window": ("real", 0, 1), "structure_sigma": ("real", 0, 8),
         "tileable": "bool", "memory_budget": "budget", "seed": "seed", "ctx": "ctx",

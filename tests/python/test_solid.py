@@ -518,6 +518,22 @@ def test_structure_sigma_is_the_split_of_the_mean_and_the_exemplar_values():
     assert np.abs(split - values).mean() > 0.003  # the split moved the solid (measured 0.0067, seed 7)
 
 
+def test_feature_scale_zero_is_the_neighbourhood_and_another_changes_the_solid():
+    # feature_scale 0 (the default) is the neighbourhood's edge: the same
+    # solid, bit for bit, as feature_scale=neighborhood; a wider scale makes
+    # another feature channel and so another solid.
+    assert _native.SOLID_DEFAULT_FEATURE_SCALE == 0 and _native.SOLID_MAX_FEATURE_SCALE == 64
+    ex = exemplar("crackedground.png", size=48)
+    opts = dict(size=24, levels=2, iterations=2, seed=3, rotate_exemplar="off")
+    default = optimizer_solid(ex, **opts)["solid"]
+    np.testing.assert_array_equal(optimizer_solid(ex, feature_scale=8, neighborhood=8, **opts)["solid"], default)
+    wider = optimizer_solid(ex, feature_scale=16, **opts)["solid"]
+    assert wider.shape == default.shape and np.abs(wider - default).mean() > 1e-3
+    for bad in (-1, 65):
+        with pytest.raises(_native.InvalidInputError, match="feature_scale"):
+            optimizer_solid(ex, feature_scale=bad, **opts)
+
+
 def test_quality_metrics_on_known_cases():
     # The metrics themselves: an exemplar against itself is a perfect, fully
     # copied match; its 3x3 box blur is less sharp; shuffled pixels are far.

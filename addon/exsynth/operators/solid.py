@@ -166,6 +166,7 @@ class SolidJob(Job):
     method: str = None              # one of _native.SOLID_METHODS; None = the engine's default
     feature_weight: float = _native.SOLID_DEFAULT_FEATURE_WEIGHT  # the optimiser's; 0 = off
     feature_threshold: float = _native.SOLID_DEFAULT_FEATURE_THRESHOLD  # which dark pixels are features
+    feature_scale: int = _native.SOLID_DEFAULT_FEATURE_SCALE  # exemplar pixels; 0 = the neighbourhood's
     rotate_exemplar: str = _native.SOLID_DEFAULT_ROTATE_EXEMPLAR  # its quarter turns: off, on, auto
     histogram_values: float = _native.SOLID_DEFAULT_HISTOGRAM_VALUES  # the optimiser's; 0 = off
     structure_sigma: float = _native.SOLID_DEFAULT_STRUCTURE_SIGMA  # the optimiser's, in voxels; 0 = off
@@ -186,7 +187,7 @@ class SolidJob(Job):
             levels=self.levels, iterations=self.iterations, seed=self.seed,
             memory_budget=self.memory_budget, ctx=ctx, method=self.method or _native.SOLID_DEFAULT_METHOD,
             feature_weight=self.feature_weight, feature_threshold=self.feature_threshold,
-            rotate_exemplar=self.rotate_exemplar, histogram_values=self.histogram_values,
+            feature_scale=self.feature_scale, rotate_exemplar=self.rotate_exemplar, histogram_values=self.histogram_values,
             structure_sigma=self.structure_sigma,
         )
         solid = Solid(res["solid"], self.scale / self.size, list(res["energy"]), tuple(res["rotated_exemplar"]))
@@ -376,7 +377,8 @@ class EXSYNTH_OT_solid_texture(JobOperator, bpy.types.Operator):
             exemplar_y=exemplar_y, exemplar_z=exemplar_z, size=settings.solid_size,
             levels=settings.solid_levels, iterations=settings.solid_iterations,
             method=settings.solid_method.lower(), feature_weight=settings.solid_feature_weight,
-            feature_threshold=settings.solid_feature_threshold, rotate_exemplar=settings.solid_rotate_exemplar.lower(),
+            feature_threshold=settings.solid_feature_threshold, feature_scale=settings.solid_feature_scale,
+            rotate_exemplar=settings.solid_rotate_exemplar.lower(),
             histogram_values=settings.solid_histogram_values, structure_sigma=settings.solid_structure_sigma,
             scale=settings.solid_scale, seed=settings.seed,
             memory_budget=settings.memory_budget_bytes, encoding=encoding, anchor=anchor,

@@ -86,6 +86,9 @@ class EXSYNTH_PT_solid_advanced(SidebarPanel, bpy.types.Panel):
         row = col.row()
         row.active = settings.solid_feature_weight > 0  # the threshold picks the features the weight weighs
         row.prop(settings, "solid_feature_threshold")
+        row = col.row()
+        row.active = settings.solid_feature_weight > 0  # the scale shapes the channel the weight weighs
+        row.prop(settings, "solid_feature_scale")
         col.prop(settings, "solid_rotate_exemplar")
         col.prop(settings, "solid_histogram_values")
         col.prop(settings, "solid_structure_sigma")

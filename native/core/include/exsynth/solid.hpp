@@ -121,6 +121,9 @@ constexpr RotateExemplar kSolidRotateExemplar = RotateExemplar::Auto;
 /// Upper end of TextureOptimizationOptions::structure_sigma, in voxels.
 constexpr double kMaxStructureSigma = 8.0;
 
+/// Upper end of TextureOptimizationOptions::feature_scale, in exemplar pixels.
+constexpr int kMaxFeatureScale = 64;
+
 /// Bins per value channel of TextureOptimizationOptions::histogram_values
 /// (the quality measure's hist_emd uses 32 over the 8-bit range).
 constexpr int kValueBins = 32;
@@ -208,6 +211,17 @@ struct TextureOptimizationOptions {
   /// crackedground's cells come out as parallel sheets: docs/solid.md,
   /// thirteenth and fourteenth passes). Up to kMaxFeatureThreshold.
   double feature_threshold = 0.0;
+  /// The feature channel's scale in exemplar pixels (of the working
+  /// resolution): its distance saturates this far from a feature's edge,
+  /// and a feature is darker than the mean of the window of this radius
+  /// (with_feature_channel); 0 = the neighbourhood's edge n (the default,
+  /// 8). Larger scales tell a stone's
+  /// middle from its rim: crackedground's cow shows whole round stones in a
+  /// dark matrix at 16 where 8 breaks them into small cells, but on other
+  /// exemplars it can line features up as sheets (marble2, sky) or lose
+  /// contrast (granite1), so 0 stays the default (docs/solid.md, nineteenth
+  /// pass). Up to kMaxFeatureScale.
+  int feature_scale = 0;
   /// On: the exemplar is used in its four quarter turns (its central
   /// square, as one mosaic): for textures with no preferred direction
   /// (cracks, cells, pebbles), whose cells otherwise line up as parallel

@@ -45,6 +45,7 @@ void check_options(const TextureOptimizationOptions& o) {
   range("histogram_strength", o.histogram_strength, 0, 16, " (1 = the gentle weighting, 3 = default)");
   range("feature_weight", o.feature_weight, 0, 100, " (0 = off)");
   range("feature_threshold", o.feature_threshold, 0, kMaxFeatureThreshold, " (0 = darker than the window's mean at all)");
+  range("feature_scale", o.feature_scale, 0, kMaxFeatureScale, " pixels (0 = the neighbourhood's edge)");
   range("histogram_values", o.histogram_values, 0, 100, " (0 = off)");
   range("histogram_value_rounds", o.histogram_value_rounds, 1, 64, "");
   range("histogram_value_window", o.histogram_value_window, 0, 1, " (0 = each texel's own price)");
@@ -210,9 +211,10 @@ void prepare_exemplars(const Job& job, const TextureOptimizationOptions& opt, Pr
   // The feature-distance channel, appended after the exemplar's channels: the
   // constraint's targets (the exemplar's channels) leave it free.
   if (opt.feature_weight > 0) {
+    const int scale = opt.feature_scale > 0 ? opt.feature_scale : opt.neighborhood;
     p.featured.reserve(p.images.size());
     for (const Image* img : p.images)
-      p.featured.push_back(solid::with_feature_channel(*img, float(opt.feature_weight), opt.neighborhood, opt.feature_threshold));
+      p.featured.push_back(solid::with_feature_channel(*img, float(opt.feature_weight), scale, opt.feature_threshold));
     for (std::size_t e = 0; e < p.images.size(); ++e) p.images[e] = &p.featured[e];
     ++p.channels;
   }
