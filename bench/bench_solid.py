@@ -38,13 +38,16 @@ CASES = {
     # structure_sigma (docs/solid.md, eighteenth pass): the finest level's mean as well, the split, the match
     "solid128_split": ("solid 128^3 RGB, structure_sigma 1.5",
                        "res = _native.synthesize_solid(ex, size=128, levels=3, seed=1, structure_sigma=1.5)"),
+    # feature_scale (docs/solid.md, nineteenth pass): a wider feature channel, the same work otherwise
+    "solid128_scale16": ("solid 128^3 RGB, feature_scale 16",
+                         "res = _native.synthesize_solid(ex, size=128, levels=3, seed=1, feature_scale=16)"),
     "solid256": ("solid 256^3 RGB, 3 levels", "res = _native.synthesize_solid(ex, size=256, levels=3, seed=1)"),
     "image256": ("image 128^2 -> 256^2, 3 levels", "res = _native.synthesize_image(ex, width=256, height=256, seed=1)"),
     # method="coordinates" (exemplar coordinates; the solid rows above use the default method)
     "coord64": ("solid 64^3 RGB, coordinates", "res = _native.synthesize_solid(ex, size=64, seed=1, method='coordinates')"),
     "coord128": ("solid 128^3 RGB, coordinates", "res = _native.synthesize_solid(ex, size=128, seed=1, method='coordinates')"),
 }
-DEFAULT_CASES = "solid128,solid128_unturned,solid128_t0,solid128_brick,solid128_split,solid256,image256"
+DEFAULT_CASES = "solid128,solid128_unturned,solid128_t0,solid128_brick,solid128_split,solid128_scale16,solid256,image256"
 
 
 CHILD = """

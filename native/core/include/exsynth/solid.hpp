@@ -215,12 +215,11 @@ struct TextureOptimizationOptions {
   /// resolution): its distance saturates this far from a feature's edge,
   /// and a feature is darker than the mean of the window of this radius
   /// (with_feature_channel); 0 = the neighbourhood's edge n (the default,
-  /// 8). Larger scales tell a stone's
-  /// middle from its rim: crackedground's cow shows whole round stones in a
-  /// dark matrix at 16 where 8 breaks them into small cells, but on other
-  /// exemplars it can line features up as sheets (marble2, sky) or lose
-  /// contrast (granite1), so 0 stays the default (docs/solid.md, nineteenth
-  /// pass). Up to kMaxFeatureScale.
+  /// 8). Larger scales tell a stone's middle from its rim: crackedground's
+  /// cow shows whole round stones in a dark matrix at 16 where 8 breaks
+  /// them into small cells, but on other exemplars it lines features up as
+  /// sheets (marble2, sky) or loses contrast (granite1), so 0 stays the
+  /// default (docs/solid.md, nineteenth pass). Up to kMaxFeatureScale.
   int feature_scale = 0;
   /// On: the exemplar is used in its four quarter turns (its central
   /// square, as one mosaic): for textures with no preferred direction
