@@ -16,7 +16,7 @@ namespace {
 
 // Embree hands the filter our context; the collector rides behind it.
 struct CollectContext {
-  RTCIntersectContext base;
+  RayContext base;
   const std::vector<std::array<float, 3>>* normals;
   int axis;
   std::vector<Crossing>* out;
@@ -24,7 +24,7 @@ struct CollectContext {
 
 // Records every hit and rejects it, so traversal continues to the next one.
 void collect_filter(const RTCFilterFunctionNArguments* args) {
-  auto* ctx = reinterpret_cast<CollectContext*>(args->context);
+  const auto* ctx = reinterpret_cast<const CollectContext*>(args->context);
   for (unsigned i = 0; i < args->N; ++i) {
     if (args->valid[i] != -1) continue;
     const unsigned prim = RTCHitN_primID(args->hit, args->N, i);
@@ -84,7 +84,7 @@ AxisRayCaster::~AxisRayCaster() {
 void AxisRayCaster::crossings(int axis, float u, float v, std::vector<Crossing>& out) const {
   out.clear();
   CollectContext ctx;
-  rtcInitIntersectContext(&ctx.base);
+  init_context(ctx.base);
   ctx.normals = &normals_;
   ctx.axis = axis;
   ctx.out = &out;
@@ -110,7 +110,7 @@ void AxisRayCaster::crossings(int axis, float u, float v, std::vector<Crossing>&
   rh.ray.flags = 0;
   rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
   rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
-  embree().Intersect1(scene_, &ctx.base, &rh);
+  intersect1(scene_, ctx.base, rh);
 
   std::sort(out.begin(), out.end());
   // Merge same-facing crossings at (nearly) the same position.

@@ -6,9 +6,8 @@
 #include <cstdint>
 #include <vector>
 
-#include <embree3/rtcore.h>
-
 #include "exsynth/mesh.hpp"
+#include "voxel/embree_api.hpp"
 
 namespace exsynth::voxel {
 

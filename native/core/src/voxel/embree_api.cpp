@@ -9,21 +9,25 @@
 namespace exsynth::voxel {
 namespace {
 
+#if EXSYNTH_EMBREE_MAJOR == 4
+constexpr const char* kLibrary = "libembree4.so.4";
+#else
 constexpr const char* kLibrary = "libembree3.so.3";
+#endif
 
 // Called from here, dlopen searches this object's run path first ($ORIGIN/lib
 // in a packaged add-on) and returns the copy already loaded as the module's
 // dependency.
 void* open_library() {
   void* handle = dlopen(kLibrary, RTLD_NOW | RTLD_LOCAL);
-  if (!handle) throw Error(std::string("cannot load Embree 3 (") + kLibrary + "): " + dlerror());
+  if (!handle) throw Error(std::string("cannot load Embree (") + kLibrary + "): " + dlerror());
   return handle;
 }
 
 template <class F>
 void bind(void* handle, const char* name, F& slot) {
   void* f = dlsym(handle, name);  // this library's definition, not the global scope's
-  if (!f) throw Error(std::string("Embree 3 (") + kLibrary + ") has no " + name);
+  if (!f) throw Error(std::string("Embree (") + kLibrary + ") has no " + name);
   slot = reinterpret_cast<F>(f);
 }
 
@@ -54,5 +58,22 @@ const EmbreeApi& embree() {
   static const EmbreeApi api = load();
   return api;
 }
+
+const char* embree_library() { return kLibrary; }
+
+#if EXSYNTH_EMBREE_MAJOR == 4
+void init_context(RayContext& ctx) { rtcInitRayQueryContext(&ctx); }
+
+void intersect1(RTCScene scene, RayContext& ctx, RTCRayHit& rayhit) {
+  RTCIntersectArguments args;
+  rtcInitIntersectArguments(&args);
+  args.context = &ctx;
+  embree().Intersect1(scene, &rayhit, &args);
+}
+#else
+void init_context(RayContext& ctx) { rtcInitIntersectContext(&ctx); }
+
+void intersect1(RTCScene scene, RayContext& ctx, RTCRayHit& rayhit) { embree().Intersect1(scene, &ctx, &rayhit); }
+#endif
 
 }  // namespace exsynth::voxel
