@@ -1,12 +1,19 @@
 # SPDX-License-Identifier: GPL-3.0-or-later
-"""Builds the installable zips from the staged add-on (build/addon/exsynth):
+"""Builds the installable zips from the staged add-on (build/addon/exsynth),
+for the Python this script runs under (the one the module was built for):
 
     /usr/bin/python3 packaging/make_package.py --build build --out build/dist
 
-- exsynth-VERSION-linux_x64.zip: a Blender 4.2+ extension (blender_manifest.toml
-  at the root), for Edit > Preferences > Get Extensions > Install from Disk;
-- exsynth-VERSION-legacy-addon.zip: the same package in an exsynth/ folder, for
-  Edit > Preferences > Add-ons > Install (Blender 3.x with Python 3.11).
+- exsynth-VERSION-blender-RANGE-linux_x64.zip: a Blender 4.2+ extension
+  (blender_manifest.toml at the root), for Edit > Preferences > Get Extensions
+  > Install from Disk; its manifest's Blender range is the releases that run
+  this Python (addon/exsynth/platforms.py), so Blender refuses it elsewhere;
+- exsynth-VERSION-legacy-addon-pythonX.Y.zip: the same package in an exsynth/
+  folder, for Edit > Preferences > Add-ons > Install (Blender 3.x, and
+  distributions' Blender builds, with this Python).
+
+`./exsynth package` runs this once on this machine and once in a Debian root
+with the other Python (Debian 12: 3.11, Debian 13: 3.13).
 
 Both carry the compiled module and every shared library it needs that an
 official Blender and a common Linux desktop lack, in exsynth/lib/, found with
@@ -17,7 +24,8 @@ is reused when Blender has loaded it first; oneTBB keeps that ABI backward
 compatible, so the module built against Debian's 2021.8 runs on Blender's newer
 one. Embree 3 and Blender's Embree 4 share C function names: the module reaches
 Embree through dlsym on its own copy (native/core/src/voxel/embree_api.hpp).
-Both tested by tests/package/test_extension.py.
+Both tested by tests/package/test_extension.py. Printed: the newest glibc
+symbol version the zip's binaries need (the oldest glibc that loads them).
 """
 
 import argparse
@@ -40,8 +48,6 @@ SYSTEM_LIBRARIES = re.compile(
     r"|libstdc\+\+|libgcc_s)\.so"
 )
 LIB_DIR = "lib"
-# Loaded by the module with dlopen, so ldd does not list them: bundled too.
-DLOPENED = ("libembree3.so.3",)  # native/core/src/voxel/embree_api.cpp
 
 MANIFEST = """\
 schema_version = "1.0.0"
@@ -54,13 +60,19 @@ maintainer = "exsynth contributors"
 type = "add-on"
 tags = ["Modeling", "Mesh", "Material"]
 
-blender_version_min = "4.2.0"
-license = ["SPDX:{license}"]
+blender_version_min = "{blender_min}"
+{blender_max}license = ["SPDX:{license}"]
 platforms = ["linux-x64"]
 
 [permissions]
 files = "Read meshes and images, write volumes, meshes and textures"
 """
+
+
+def manifest_text(version, license_id, blender_min, blender_max):
+    """blender_manifest.toml of the extension for Blender [min, max)."""
+    return MANIFEST.format(version=version, license=license_id, blender_min=blender_min,
+                           blender_max=f'blender_version_max = "{blender_max}"\n' if blender_max else "")
 
 
 def addon_version(init_py):
@@ -79,6 +91,17 @@ def spdx_license(license_file):
     if "GNU GENERAL PUBLIC LICENSE" in text and "Version 3" in text:
         return "GPL-3.0-or-later"
     raise SystemExit(f"make_package: cannot tell the SPDX id of {license_file}; add it to spdx_license()")
+
+
+def symbol_floor(paths, prefix):
+    """The newest `prefix`x.y[.z] symbol version (GLIBC_, GLIBCXX_) any of
+    `paths` needs from the system, as a tuple of ints."""
+    newest = (0,)
+    for path in paths:
+        out = subprocess.run(["objdump", "-T", path], check=True, capture_output=True, text=True).stdout
+        for version in re.findall(r"\*UND\*\s+\S+\s+(?:\(|)" + prefix + r"(\d+(?:\.\d+)+)", out):
+            newest = max(newest, tuple(int(p) for p in version.split(".")))
+    return newest
 
 
 def needed_libraries(path):
@@ -115,7 +138,7 @@ def patchelf(*args):
     subprocess.run(["patchelf", *args], check=True)
 
 
-def stage(addon_dir, dest):
+def stage(addon_dir, dest, dlopened):
     """Copies the add-on into dest/exsynth with its libraries in lib/."""
     pkg = os.path.join(dest, "exsynth")
     shutil.copytree(addon_dir, pkg, ignore=shutil.ignore_patterns("__pycache__", "*.pyc", LIB_DIR))
@@ -124,7 +147,7 @@ def stage(addon_dir, dest):
         raise SystemExit(f"make_package: expected one compiled _native module in {addon_dir}, found {natives}")
     native = os.path.join(pkg, natives[0])
     libs = needed_libraries(native)
-    for soname in DLOPENED:
+    for soname in dlopened:  # loaded with dlopen, so ldd does not list them
         path = system_library(soname)
         libs[soname] = path
         libs.update(needed_libraries(path))
@@ -169,17 +192,33 @@ def main(argv=None):
     os.makedirs(out, exist_ok=True)
     version = addon_version(os.path.join(addon_dir, "__init__.py"))
     license_id = spdx_license(os.path.join(ROOT, "LICENSE"))
+    # The staged add-on's own table and module (built for this Python).
+    sys.path.insert(0, os.path.dirname(addon_dir))
+    from exsynth import _native, platforms
+
+    python = sys.version_info[:2]
+    if tuple(python) not in platforms.PYTHONS:
+        raise SystemExit(f"make_package: no Blender release runs Python {python[0]}.{python[1]} "
+                         f"(addon/exsynth/platforms.py knows {sorted(platforms.PYTHONS)})")
+    blender_min, blender_max = platforms.manifest_range(python)
     with tempfile.TemporaryDirectory() as tmp:
-        pkg, libs = stage(addon_dir, tmp)
-        legacy = os.path.join(out, f"exsynth-{version}-legacy-addon.zip")
+        pkg, libs = stage(addon_dir, tmp, [_native.EMBREE_LIBRARY])
+        binaries = [os.path.join(pkg, n) for n in os.listdir(pkg) if n.endswith(".so")]
+        binaries += [os.path.join(pkg, LIB_DIR, n) for n in libs]
+        glibc, glibcxx = symbol_floor(binaries, "GLIBC_"), symbol_floor(binaries, "GLIBCXX_")
+        legacy = os.path.join(out, platforms.legacy_zip(version, python))
         write_zip(legacy, pkg, "exsynth")
         with open(os.path.join(pkg, "blender_manifest.toml"), "w", encoding="utf-8") as fh:
-            fh.write(MANIFEST.format(version=version, license=license_id))
-        extension = os.path.join(out, f"exsynth-{version}-linux_x64.zip")
+            fh.write(manifest_text(version, license_id, blender_min, blender_max))
+        extension = os.path.join(out, platforms.extension_zip(version, python))
         write_zip(extension, pkg)
-    print(f"bundled {len(libs)} libraries: {' '.join(libs)}")
+    print(f"Python {python[0]}.{python[1]} ({platforms.blender_range(python)}): "
+          f"bundled {len(libs)} libraries: {' '.join(libs)}")
     for path in (extension, legacy):
         print(f"{path}  ({os.path.getsize(path) / 1e6:.1f} MB)")
+    dotted = lambda v: ".".join(map(str, v))  # noqa: E731
+    print(f"system floor: the binaries need glibc {dotted(glibc)} (GLIBC_{dotted(glibc)}) and the "
+          f"libstdc++ of GLIBCXX_{dotted(glibcxx)} or newer")
     return 0
 
 

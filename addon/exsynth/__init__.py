@@ -34,11 +34,10 @@ def register():
     try:
         from . import _native  # noqa: F401  (fail here, with advice, rather than on first use)
     except ImportError as exc:
-        raise ImportError(
-            "exsynth: the compiled module exsynth._native is missing or does not load "
-            f"({exc}). Build it with `./exsynth build` and enable the add-on from build/addon/, "
-            "or install the zip from `./exsynth package` (Linux x64, Blender with Python 3.11)."
-        ) from exc
+        from . import platforms
+
+        # One line, no chained traceback: which zip this Blender needs.
+        raise ImportError(platforms.module_failure(__path__[0], bl_info["version"], bpy.app.version, exc)) from None
 
     done, attached = [], []
     try:

@@ -119,8 +119,9 @@ def autocorrelation(a):
     a = np.asarray(a, np.float64)
     a = a - a.mean()
     shape = [2 * n for n in a.shape]
-    F = np.fft.rfftn(a, shape)
-    ac = np.fft.irfftn(F * np.conj(F), shape)
+    axes = list(range(a.ndim))  # NumPy 2 wants them named beside the shape
+    F = np.fft.rfftn(a, shape, axes)
+    ac = np.fft.irfftn(F * np.conj(F), shape, axes)
     return np.fft.fftshift(ac / max(ac.flat[0], 1e-30))
 
 

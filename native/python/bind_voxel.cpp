@@ -11,6 +11,7 @@ namespace py = pybind11;
 namespace exsynth::py_bind {
 
 void bind_voxel(py::module_& m) {
+  m.attr("EMBREE_LIBRARY") = embree_library();  // what ./exsynth package must bundle
   m.def(
       "voxelize",
       [](const ArrayArg& vertices, const ArrayArg& faces, const IntArg& resolution,

@@ -3,12 +3,14 @@
 
     BLENDER_USER_RESOURCES=EMPTY_DIR VENV/bin/python extension_job.py ZIP MODE OUT.json
 
-Installs the extension zip into the (empty) user folder, enables it, runs a
-Voxelize and a Geometric Texture job and a small Cycles render (Blender's own
+Installs the extension zip into the (empty) user folder, enables it, runs
+each tool once (Voxelize, Direction Field, Geometric Texture, Solid Texture,
+Surface Texture, Point Texture) and a small Cycles render (Blender's own
 Embree 4 in the same process), and writes what it saw as JSON. MODE "global"
 loads Blender's libraries into the global symbol scope first, as the blender
 executable has them (its own dependencies), where same-named symbols of
-Blender's Embree 4 would otherwise capture the module's Embree 3 calls.
+Blender's Embree 4 would otherwise capture the module's Embree calls. MODE
+"refused": only the install, expected to be refused; its reports are kept.
 """
 
 import json
@@ -27,12 +29,21 @@ import importlib.util  # noqa: E402
 
 import numpy as np  # noqa: E402
 
-seen = {"mode": mode, "blender": bpy.app.version_string}
+seen = {"mode": mode, "blender": ".".join(map(str, bpy.app.version))}
 # The build tree and a system-wide exsynth are out of reach.
 seen["exsynth_importable_before"] = importlib.util.find_spec("exsynth") is not None
 seen["build_tree_on_path"] = [p for p in sys.path if os.path.join("build", "addon") in p]
 
 bpy.ops.wm.read_factory_settings(use_empty=True)
+if mode == "refused":
+    # Blender's refusal is an ERROR report (printed to stdout), not a result.
+    seen["install"] = sorted(bpy.ops.extensions.package_install_files(
+        filepath=zip_path, repo="user_default", enable_on_install=True))
+    seen["addons"] = sorted(k for k in bpy.context.preferences.addons.keys() if "exsynth" in k)
+    with open(out_path, "w", encoding="utf-8") as fh:
+        json.dump(seen, fh, indent=1)
+    sys.stdout.flush()
+    os._exit(0)
 seen["install"] = sorted(bpy.ops.extensions.package_install_files(
     filepath=zip_path, repo="user_default", enable_on_install=True))
 seen["addons"] = sorted(k for k in bpy.context.preferences.addons.keys() if "exsynth" in k)
@@ -68,6 +79,32 @@ settings.geo_resolution = 40
 seen["geometric_texture"] = sorted(bpy.ops.exsynth.geometric_texture())
 results = [o for o in bpy.data.objects if o.type == 'MESH' and o is not torus]
 seen["texture_results"] = [(o.name, len(o.data.vertices)) for o in results]
+
+
+def run_tool(name, op):
+    """One tool on the torus (active and selected); its new objects' names."""
+    before = set(bpy.data.objects)
+    bpy.context.view_layer.objects.active = torus
+    for obj in bpy.data.objects:
+        obj.select_set(obj is torus)
+    seen["tools"][name] = sorted(op())
+    seen["tool_results"][name] = sorted(o.name for o in set(bpy.data.objects) - before)
+
+
+ASSETS = os.path.join(os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)))), "assets")
+seen["tools"], seen["tool_results"] = {}, {}
+settings.field_preset, settings.field_axis = 'AROUND_AXIS', 'Z'
+run_tool("direction_field", bpy.ops.exsynth.direction_field)
+exemplar = bpy.data.images.load(os.path.join(ASSETS, "textures", "crackedground.png"))
+settings.solid_exemplar = exemplar
+settings.solid_size, settings.solid_levels, settings.solid_iterations = 16, 2, 2
+settings.solid_bake_resolution = 64
+run_tool("solid_texture", bpy.ops.exsynth.solid_texture)
+settings.surface_exemplar = exemplar
+settings.surface_size_mode, settings.surface_face_resolution = 'FACE', 4
+run_tool("surface_texture", bpy.ops.exsynth.surface_texture)
+settings.pts_density, settings.pts_width, settings.pts_depth, settings.pts_patch_size = 2500.0, 1.0, 1.0, 0.45
+run_tool("point_texture", bpy.ops.exsynth.point_texture)
 
 # Cycles (Blender's Embree 4) in the same process, after the module ran.
 scene = bpy.context.scene

@@ -1,5 +1,5 @@
 # SPDX-License-Identifier: GPL-3.0-or-later
-"""Runs inside Debian's Blender 3.4 (started by test_extension.py):
+"""Runs inside Debian's Blender (3.4 on Debian 12, 4.3 on 13; started by test_extension.py):
 
     BLENDER_USER_SCRIPTS=EMPTY_DIR blender -b --factory-startup --python legacy_job.py -- ZIP OUT.json
 
@@ -15,7 +15,7 @@ import bpy
 import numpy as np
 
 zip_path, out_path = sys.argv[sys.argv.index("--") + 1:][:2]
-seen = {"blender": bpy.app.version_string}
+seen = {"blender": bpy.app.version_string, "python": list(sys.version_info[:2])}
 seen["install"] = sorted(bpy.ops.preferences.addon_install(filepath=zip_path))
 
 

@@ -21,6 +21,10 @@ constexpr int kMaxVoxelResolution = 1 << 14;
 constexpr int kMaxVoxelPadding = 1024;
 constexpr int kMaxSupersample = 8;
 
+/// The Embree library the voxelizer loads at run time ("libembree3.so.3" or
+/// "libembree4.so.4", by what the build found): a package must carry it.
+const char* embree_library();
+
 struct VoxelizeOptions {
   int resolution = 128;       ///< voxels along the longest bounding-box axis (when voxel_size == 0)
   double voxel_size = 0.0;    ///< > 0: voxel edge length in mesh units (overrides resolution)

@@ -5,7 +5,7 @@
 #include <string>
 
 #include <Eigen/Geometry>
-#include <nanoflann.hpp>
+#include "search/nanoflann_compat.hpp"
 
 #include "exsynth/errors.hpp"
 #include "exsynth/parallel.hpp"
@@ -75,7 +75,7 @@ VolumeFrames volume_frames(const Volume& sdf, const std::vector<Eigen::Vector3f>
   for (std::size_t i = 0; i < points.size(); ++i) cloud.row(Eigen::Index(i)) = points[i].transpose();
   StageProgress field_index(ctx, "frames: field index", 0.2, 0.2, 1);
   Tree tree(3, std::cref(cloud), 16);
-  tree.index->buildIndex();
+  search::nf::ensure_built(search::nf::index(tree));
   field_index.check();
   std::vector<float> dist2(voxels, voxel::kFarAway);
   std::vector<std::int32_t> label(voxels, -1);
@@ -90,7 +90,7 @@ VolumeFrames volume_frames(const Volume& sdf, const std::vector<Eigen::Vector3f>
       float d2 = 0;
       nanoflann::KNNResultSet<float, Eigen::Index> result(1);
       result.init(&nearest, &d2);
-      tree.index->findNeighbors(result, q, nanoflann::SearchParams());
+      search::nf::index(tree).findNeighbors(result, q, search::nf::params());
       set3(f.t, v, tangent_of(vectors[std::size_t(nearest)], get3(f.n, v)));
       dist2[v] = 0.0f;
       label[v] = std::int32_t(v);  // the voxel itself: the transform carries surface voxels

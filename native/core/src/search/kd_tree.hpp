@@ -5,7 +5,7 @@
 // tree is built the same way every time).
 #include <functional>
 
-#include <nanoflann.hpp>
+#include "search/nanoflann_compat.hpp"
 
 #include "search/pca.hpp"
 
@@ -15,7 +15,7 @@ class KdTree {
  public:
   using Tree = nanoflann::KDTreeEigenMatrixAdaptor<RowMatrixXf, -1, nanoflann::metric_L2_Simple>;
   explicit KdTree(const RowMatrixXf& points, int leaf_size = 16) : tree_(int(points.cols()), std::cref(points), leaf_size) {
-    tree_.index->buildIndex();
+    nf::ensure_built(nf::index(tree_));
   }
 
   /// Row of the (1 + eps)-approximate nearest neighbour of q (eps = 0: exact).
@@ -31,7 +31,7 @@ class KdTree {
   std::size_t knn(const float* q, std::size_t k, Eigen::Index* idx, float* d2, float eps = 0.0f) const {
     nanoflann::KNNResultSet<float, Eigen::Index> result(k);
     result.init(idx, d2);
-    tree_.index->findNeighbors(result, q, nanoflann::SearchParams(32, eps));
+    nf::index(tree_).findNeighbors(result, q, nf::params(eps));
     return result.size();
   }
 

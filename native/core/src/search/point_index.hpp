@@ -6,7 +6,8 @@
 #include <vector>
 
 #include <Eigen/Core>
-#include <nanoflann.hpp>
+
+#include "search/nanoflann_compat.hpp"
 
 namespace exsynth::search {
 
@@ -14,7 +15,7 @@ class PointIndex {
  public:
   explicit PointIndex(const std::vector<Eigen::Vector3f>& points)
       : adaptor_{&points}, tree_(3, adaptor_, nanoflann::KDTreeSingleIndexAdaptorParams(12)) {
-    if (!points.empty()) tree_.buildIndex();
+    if (!points.empty()) nf::ensure_built(tree_);
   }
   PointIndex(const PointIndex&) = delete;
   PointIndex& operator=(const PointIndex&) = delete;
@@ -26,8 +27,8 @@ class PointIndex {
   void radius(const Eigen::Vector3f& q, float radius, std::vector<std::pair<std::size_t, float>>& out) const {
     out.clear();
     if (size() == 0) return;
-    nanoflann::SearchParams params(32, 0.0f, false);
-    tree_.radiusSearch(q.data(), radius * radius, out, params);
+    nf::RadiusCollector<std::size_t, float> collect(radius * radius, out);
+    tree_.findNeighbors(collect, q.data(), nf::params(0.0f, false));
   }
 
   /// Up to k nearest: fills idx / d2 and returns how many were found.
@@ -35,7 +36,7 @@ class PointIndex {
     if (size() == 0) return 0;
     nanoflann::KNNResultSet<float, std::size_t> result(k);
     result.init(idx, d2);
-    tree_.findNeighbors(result, q.data(), nanoflann::SearchParams(32));
+    tree_.findNeighbors(result, q.data(), nf::params());
     return result.size();
   }
 

@@ -25,7 +25,7 @@
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
-#include <nanoflann.hpp>
+#include "search/nanoflann_compat.hpp"
 
 #include "exsynth/parallel.hpp"
 #include "exsynth/pyramid.hpp"
@@ -427,7 +427,7 @@ class MultiscaleSolver {
       ix->pca = search::fit_pca(ix->X, opt_.pca_variance, opt_.max_pca_dims, &progress);
       ix->Y = ix->pca.project(ix->X);
       ix->tree = std::make_unique<PassIndex::Tree>(int(ix->Y.cols()), std::cref(ix->Y), 16);
-      ix->tree->index->buildIndex();
+      search::nf::ensure_built(search::nf::index(*ix->tree));
     }
     return ix;
   }
@@ -522,12 +522,10 @@ class MultiscaleSolver {
       }
     }
     const std::size_t k = s.idx.size();
-    nanoflann::KNNResultSet<float, std::size_t> result(k);
-    result.init(s.idx.data(), s.d2.data());
-    // (nanoflann keeps its k-th distance in the last slot: a bound there
-    // prunes the search until k matches inside it are found.)
-    if (coh) s.d2[k - 1] = coh_d2 / float(1.0 + opt_.coherence);
-    ix.tree->index->findNeighbors(result, s.qp.data(), nanoflann::SearchParams(32, kSearchEps));
+    // The bound prunes the search until k matches inside it are found.
+    const float bound = coh ? coh_d2 / float(1.0 + opt_.coherence) : std::numeric_limits<float>::max();
+    search::nf::BoundedKnn<std::size_t, float> result(k, s.idx.data(), s.d2.data(), bound);
+    search::nf::index(*ix.tree).findNeighbors(result, s.qp.data(), search::nf::params(kSearchEps));
     if (result.size() == 0) return *coh;  // nothing (1 + coherence) closer
     s.best.clear();
     for (std::size_t i = 0; i < result.size(); ++i) {

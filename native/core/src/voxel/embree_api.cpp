@@ -7,13 +7,14 @@
 #include "exsynth/errors.hpp"
 
 namespace exsynth::voxel {
-namespace {
 
 #if EXSYNTH_EMBREE_MAJOR == 4
 constexpr const char* kLibrary = "libembree4.so.4";
 #else
 constexpr const char* kLibrary = "libembree3.so.3";
 #endif
+
+namespace {
 
 // Called from here, dlopen searches this object's run path first ($ORIGIN/lib
 // in a packaged add-on) and returns the copy already loaded as the module's
@@ -59,7 +60,13 @@ const EmbreeApi& embree() {
   return api;
 }
 
-const char* embree_library() { return kLibrary; }
+}  // namespace exsynth::voxel
+
+namespace exsynth {
+const char* embree_library() { return voxel::kLibrary; }
+}  // namespace exsynth
+
+namespace exsynth::voxel {
 
 #if EXSYNTH_EMBREE_MAJOR == 4
 void init_context(RayContext& ctx) { rtcInitRayQueryContext(&ctx); }

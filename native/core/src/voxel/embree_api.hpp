@@ -55,9 +55,6 @@ struct EmbreeApi {
 /// library or function when Embree cannot be found.
 const EmbreeApi& embree();
 
-/// The SONAME the module loads ("libembree3.so.3" or "libembree4.so.4").
-const char* embree_library();
-
 /// A context for one query (Embree 3: rtcInitIntersectContext; 4:
 /// rtcInitRayQueryContext).
 void init_context(RayContext& ctx);
