@@ -16,6 +16,11 @@ changed and where it was checked.
 - Node trees of new materials and worlds (`use_nodes`, deprecated in 5.0).
 - The sidebar's tab: `Region.active_panel_category` (in the 4.2.23 and
   5.0.1 wheels' RNA, not in Debian's 3.4) names the tab a region shows.
+- A geometry-nodes modifier's input values: ID properties of the modifier
+  keyed by the socket's identifier (`mod["Socket_0"]`) up to 5.0; in 5.2 the
+  modifier takes no ID properties and each input is
+  `mod.properties.inputs.<identifier>.value`.
+- Group interface sockets: `group.interface` from 4.0, `group.inputs` before.
 """
 
 import bpy
@@ -88,3 +93,37 @@ def ensure_node_tree(data):
     if data.node_tree is None:
         data.use_nodes = True
     return data.node_tree
+
+
+def group_input_identifier(group, name):
+    """The identifier of node group input `name` (its key on a modifier)."""
+    if hasattr(group, "interface"):
+        for item in group.interface.items_tree:
+            if getattr(item, "in_out", None) == 'INPUT' and item.name == name:
+                return item.identifier
+        raise KeyError(f"node group {group.name!r} has no input {name!r}")
+    return group.inputs[name].identifier
+
+
+def _modifier_inputs(mod):
+    properties = getattr(mod, "properties", None)
+    return getattr(properties, "inputs", None)
+
+
+def set_modifier_input(mod, name, value):
+    """Sets the geometry-nodes modifier's input `name` (of its node group)
+    to `value`: an ID property up to 5.0, `properties.inputs` in 5.2 (checked
+    on 3.4.1, 4.5.15 and 5.2.3)."""
+    key = group_input_identifier(mod.node_group, name)
+    inputs = _modifier_inputs(mod)
+    if inputs is not None:
+        getattr(inputs, key).value = value
+    else:
+        mod[key] = value
+
+
+def modifier_input(mod, name):
+    """The value of the geometry-nodes modifier's input `name`."""
+    key = group_input_identifier(mod.node_group, name)
+    inputs = _modifier_inputs(mod)
+    return getattr(inputs, key).value if inputs is not None else mod[key]

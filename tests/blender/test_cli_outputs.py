@@ -114,9 +114,12 @@ def test_seed_up_to_2_64_minus_1_works(tmp_path, capsys):
 def test_ctrl_c_cancels_the_job_and_writes_nothing(tmp_path):
     """SIGINT to `./exsynth run` (Blender itself only notes it and carries on)."""
     out = tmp_path / "solid.npy"
+    # A bpy module sets OCIO to its own colour config (5.2's is OCIO 2.5, which
+    # Debian's Blender, started by ./exsynth, cannot read): not for the child.
+    env = {k: v for k, v in os.environ.items() if not (k == "OCIO" and "site-packages" in v)}
     proc = subprocess.Popen(
         [os.path.join(ROOT, "exsynth"), "run", "solid", "--exemplar", CRACKED, "--size", "64", "--out", str(out)],
-        stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+        stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=env)
     try:
         lines = []
         for line in proc.stderr:  # the CLI names each stage as the job reaches it

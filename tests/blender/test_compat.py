@@ -43,3 +43,37 @@ def test_world_node_tree(capfd):
         tree = compat.ensure_node_tree(world)
     no_deprecation(capfd, record)
     assert tree is world.node_tree and "Background" in tree.nodes
+
+
+def test_geometry_nodes_modifier_input_is_set_and_read_on_either_api():
+    """Up to 5.0 a modifier input is an ID property of the modifier; 5.2
+    refuses ID properties there and has `properties.inputs`. The helper takes
+    whichever this Blender has, and the evaluated geometry sees the value."""
+    bpy.ops.mesh.primitive_plane_add()
+    obj = bpy.context.active_object
+    group = bpy.data.node_groups.new("Offset", "GeometryNodeTree")
+    if hasattr(group, "interface"):
+        group.interface.new_socket("Geometry", in_out='INPUT', socket_type='NodeSocketGeometry')
+        group.interface.new_socket("Lift", in_out='INPUT', socket_type='NodeSocketFloat')
+        group.interface.new_socket("Geometry", in_out='OUTPUT', socket_type='NodeSocketGeometry')
+    else:
+        group.inputs.new('NodeSocketGeometry', "Geometry")
+        group.inputs.new('NodeSocketFloat', "Lift")
+        group.outputs.new('NodeSocketGeometry', "Geometry")
+    nodes, links = group.nodes, group.links
+    gin, gout = nodes.new("NodeGroupInput"), nodes.new("NodeGroupOutput")
+    move = nodes.new("GeometryNodeTransform")
+    combine = nodes.new("ShaderNodeCombineXYZ")
+    links.new(gin.outputs["Lift"], combine.inputs["Z"])
+    links.new(combine.outputs["Vector"], move.inputs["Translation"])
+    links.new(gin.outputs["Geometry"], move.inputs["Geometry"])
+    links.new(move.outputs["Geometry"], gout.inputs["Geometry"])
+    mod = obj.modifiers.new("Lift", 'NODES')
+    mod.node_group = group
+    compat.set_modifier_input(mod, "Lift", 0.75)
+    assert abs(compat.modifier_input(mod, "Lift") - 0.75) < 1e-6
+    depsgraph = bpy.context.evaluated_depsgraph_get()
+    mesh = obj.evaluated_get(depsgraph).to_mesh()
+    zs = {round(v.co.z, 5) for v in mesh.vertices}
+    obj.evaluated_get(depsgraph).to_mesh_clear()
+    assert zs == {0.75}

@@ -7,6 +7,7 @@ normal). Works in Blender 3.4 and 4.x (Cycles renders the instances)."""
 import bpy
 import numpy as np
 
+from .. import compat
 from . import materials
 
 NORMAL_ATTRIBUTE = "exsynth_normal"
@@ -82,17 +83,8 @@ def new_point_cloud_object(name, positions, normals, disc_radius, collection, cr
     mesh.materials.append(mat)
     mod = obj.modifiers.new("ExSynth Discs", 'NODES')
     mod.node_group = disc_node_group(mat, created)
-    key = _input_identifier(mod.node_group, "Radius")
-    mod[key] = float(disc_radius)
+    compat.set_modifier_input(mod, "Radius", float(disc_radius))
     return obj
-
-
-def _input_identifier(group, name):
-    if hasattr(group, "interface"):
-        for item in group.interface.items_tree:
-            if getattr(item, "in_out", None) == 'INPUT' and item.name == name:
-                return item.identifier
-    return group.inputs[name].identifier
 
 
 def read_point_cloud(obj):

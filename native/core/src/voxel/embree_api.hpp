@@ -12,9 +12,10 @@
 // different ABIs: bound by name, the module's Embree 3 calls land in
 // Blender's Embree 4 and Voxelize silently returns an empty grid (seen with
 // the 4.5 bpy module when its libraries are loaded into the global scope as
-// the executable has them; tests/package/test_extension.py). Embree never
-// calls its own exported functions through the PLT (no relocations against
-// rtc* in Debian's builds), so once entered, it stays in itself.
+// the executable has them; tests/package/test_extension.py). Once entered,
+// Embree stays in itself: Debian's Embree 3 calls none of its exported
+// functions through the PLT, Embree 4 only rtcForward* (user geometry
+// forwarding rays to instances, which the voxelizer does not use).
 #if EXSYNTH_EMBREE_MAJOR == 4
 #include <embree4/rtcore.h>
 #elif EXSYNTH_EMBREE_MAJOR == 3
