@@ -6,6 +6,7 @@ import subprocess
 
 import addon_utils
 import bpy
+import pytest
 
 import exsynth
 
@@ -57,3 +58,36 @@ def test_package_imports_without_bpy():
     )
     assert probe.returncode == 0, probe.stderr
     assert probe.stdout.strip() == "ExSynth"
+
+
+def test_a_module_for_another_python_fails_to_enable_with_one_line_naming_the_zip(tmp_path):
+    """A zip whose compiled module is for another Python than this Blender's
+    (a legacy zip in the wrong Blender): register() raises one line naming
+    the zip to get, with no chained traceback, and registers nothing."""
+    import importlib
+    import shutil
+    import sys
+
+    from exsynth import platforms
+
+    src = os.path.dirname(exsynth.__file__)
+    pkg = tmp_path / "exsynth_wrong_python"
+    shutil.copytree(src, pkg, ignore=shutil.ignore_patterns("__pycache__", "_native*.so"))
+    here = sys.version_info[:2]
+    other = next(p for p in sorted(platforms.PYTHONS) if p != here)
+    (pkg / f"_native.cpython-{other[0]}{other[1]}-x86_64-linux-gnu.so").write_bytes(b"\x7fELF not for this Python")
+    sys.path.insert(0, str(tmp_path))
+    classes_before = set(dir(bpy.types))
+    try:
+        wrong = importlib.import_module("exsynth_wrong_python")
+        with pytest.raises(ImportError) as raised:
+            wrong.register()
+    finally:
+        sys.path.remove(str(tmp_path))
+        for name in [n for n in sys.modules if n.startswith("exsynth_wrong_python")]:
+            del sys.modules[name]
+    message = str(raised.value)
+    assert message == platforms.wrong_module_message(exsynth.bl_info["version"], here, bpy.app.version)
+    assert "\n" not in message and platforms.extension_zip("0.1.0", here) in message
+    assert raised.value.__cause__ is None and raised.value.__suppress_context__
+    assert set(dir(bpy.types)) == classes_before
