@@ -21,6 +21,9 @@ changed and where it was checked.
   modifier takes no ID properties and each input is
   `mod.properties.inputs.<identifier>.value`.
 - Group interface sockets: `group.interface` from 4.0, `group.inputs` before.
+- Colour looks: 3.x's Filmic names them plainly ('Medium Contrast'); 4.0
+  made AgX the default view transform and prefixes each look with its view
+  transform ('AgX - Base Contrast'; seen in Debian 13's 4.3.2).
 """
 
 import bpy
@@ -127,3 +130,19 @@ def modifier_input(mod, name):
     key = group_input_identifier(mod.node_group, name)
     inputs = _modifier_inputs(mod)
     return getattr(inputs, key).value if inputs is not None else mod[key]
+
+
+def set_medium_contrast_look(view_settings):
+    """The view transform's neutral, medium-contrast look: 'Medium Contrast'
+    (Filmic, 3.x), else '<transform> - Medium Contrast', else
+    '<transform> - Base Contrast' (AgX, 4.x); left as it is when none exists.
+    Returns the look set."""
+    transform = view_settings.view_transform
+    # The looks are a dynamic enum (RNA lists only 'None'): try each name.
+    for look in ("Medium Contrast", f"{transform} - Medium Contrast", f"{transform} - Base Contrast"):
+        try:
+            view_settings.look = look
+            break
+        except TypeError:
+            continue
+    return view_settings.look

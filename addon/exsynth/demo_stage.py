@@ -50,7 +50,7 @@ def prepare_scene(scene, samples):
     scene.render.resolution_x, scene.render.resolution_y = RESOLUTION_PX
     scene.render.resolution_percentage = 100
     scene.render.image_settings.file_format = 'PNG'
-    scene.view_settings.look = 'Medium Contrast'
+    compat.set_medium_contrast_look(scene.view_settings)
 
     world = bpy.data.worlds.new("Demo World")
     background = compat.ensure_node_tree(world).nodes["Background"]

@@ -77,3 +77,12 @@ def test_geometry_nodes_modifier_input_is_set_and_read_on_either_api():
     zs = {round(v.co.z, 5) for v in mesh.vertices}
     obj.evaluated_get(depsgraph).to_mesh_clear()
     assert zs == {0.75}
+
+
+def test_medium_contrast_look_exists_in_this_blender():
+    """The demo's look: 'Medium Contrast' under 3.x's Filmic, the AgX look of
+    the same contrast from 4.0 (names prefixed by the view transform)."""
+    view = bpy.context.scene.view_settings
+    look = compat.set_medium_contrast_look(view)
+    assert look == view.look and look != 'None'
+    assert look == 'Medium Contrast' if bpy.app.version < (4, 0, 0) else look.startswith(view.view_transform + " - ")
