@@ -30,6 +30,7 @@ from .operators.voxelize import VoxelizeJob
 from .properties import GIB
 
 MESH_FORMATS = (".obj", ".ply", ".stl")
+POINTS_DENSITY = 8000.0  # --density's default: the CLI's, lower than the engine's for quicker jobs
 VOXEL_FORMATS = (".vdb", ".npy")
 
 
@@ -59,6 +60,10 @@ def main(argv=None) -> int:
         except (UsageError, outputs.OutputPathError, mesh_files.MeshFileError) as exc:
             print(f"exsynth {args.job}: error: {exc}", file=sys.stderr)
             return 2
+        except _native.InvalidInputError as exc:  # the engine's own checks: a bad argument too
+            print(f"exsynth {args.job}: error: {_with_flags(parser, args.job, str(exc))}; nothing was written",
+                  file=sys.stderr)
+            return 2
         except (KeyboardInterrupt, _native.CancelledError):
             print(f"exsynth {args.job}: interrupted (Ctrl-C); nothing was written", file=sys.stderr)
             return EXIT_INTERRUPTED
@@ -69,6 +74,24 @@ def main(argv=None) -> int:
         print(done)
         return 0
     return done
+
+
+def _with_flags(parser, job, message):
+    """The engine's message with its option names as this job's flags:
+    'face_resolution' -> --face-resolution (quoted names, and bare ones
+    with an underscore: a bare 'scale' may be a plain word)."""
+    import re
+
+    sub = next(a for a in parser._actions if isinstance(a, argparse._SubParsersAction)).choices[job]
+    for action in sub._actions:
+        flag = next((o for o in action.option_strings if o.startswith("--")), None)
+        if flag is None:
+            continue
+        name = action.dest
+        message = message.replace(f"'{name}'", flag)
+        if "_" in name:
+            message = re.sub(rf"(?<![\w-]){name}(?!\w)", flag, message)
+    return message
 
 
 # ---- running a job: Ctrl-C and progress ------------------------------------------
@@ -447,14 +470,9 @@ def _analogy_mesh(arg, path, field):
 
 def _vertex_field(path, vertices):
     """A FieldSpec from a per-vertex direction file, or a UsageError."""
-    vectors = _load_npy("--field", path).astype(np.float64)
-    _require(vectors.shape == vertices.shape,
-             f"--field: {path} is {vectors.shape}; --b has {len(vertices)} vertices: give ({len(vertices)}, 3), "
-             "one direction per vertex (e.g. './exsynth run field --mesh' on the same file)")
-    _require(bool(np.isfinite(vectors).all()), f"--field: {path} has NaN or infinite values; fix or regenerate it")
+    vectors = _directions("--field", path, vertices, "--b")
     length = np.linalg.norm(vectors, axis=1)
     given = length > 1e-8 * max(1.0, float(length.max(initial=0.0)))
-    _require(bool(given.any()), f"--field: {path} is zero everywhere, so it gives the pattern no direction")
     # Zero vectors are free: the frames fill them in from the nearest given ones.
     return analogy_ops.FieldSpec(points=np.ascontiguousarray(vertices[given]),
                                  vectors=np.ascontiguousarray(vectors[given] / length[given, None]),
@@ -475,7 +493,7 @@ def _read_curve(path):
                  "'l' lines, each vertex in at most two)")
     _require(points.ndim == 2 and points.shape[1] == 3 and len(points) >= 2,
              f"--curve: {path} must hold N >= 2 points of 3 coordinates (got shape {points.shape})")
-    _require(np.isfinite(points).all(), f"--curve: {path} has non-finite coordinates")
+    _require(np.isfinite(points).all(), f"--curve: {path} has NaN or infinite coordinates; fix or re-export the curve")
     return np.ascontiguousarray(points, np.float64)
 
 
@@ -714,9 +732,26 @@ def _run_field(args):
 def _load_npy(arg, path):
     path = _input_file(arg, path, (".npy",))
     try:
-        return np.load(path, allow_pickle=False)
+        array = np.load(path, allow_pickle=False)
     except ValueError as exc:
-        raise UsageError(f"{arg}: {path} is not a numeric .npy array ({exc})")
+        raise UsageError(f"{arg}: {path} is not a numeric .npy array ({exc})") from None
+    _require(np.issubdtype(array.dtype, np.number) and not np.issubdtype(array.dtype, np.complexfloating),
+             f"{arg}: {path} holds {array.dtype} values, not numbers; save it from a float array "
+             "(numpy.save(path, array.astype('float32')))")
+    return array
+
+
+def _directions(arg, path, vertices, mesh_flag):
+    """A V by 3 direction file for the mesh of `mesh_flag` (zero rows are free), or a UsageError."""
+    vectors = _load_npy(arg, path).astype(np.float64)
+    _require(vectors.shape == vertices.shape,
+             f"{arg}: {path} is {vectors.shape}; {mesh_flag} has {len(vertices)} vertices: give ({len(vertices)}, 3), "
+             "one direction per vertex (e.g. './exsynth run field --mesh' on the same file)")
+    _require(bool(np.isfinite(vectors).all()), f"{arg}: {path} has NaN or infinite values; fix or regenerate it")
+    _require(bool((np.linalg.norm(vectors, axis=1) > 0).any()),
+             f"{arg}: {path} is zero everywhere, so it gives the texture no direction; give a direction at some "
+             "vertices (zero rows are filled in from them)")
+    return vectors
 
 
 # ---- demo --------------------------------------------------------------------
@@ -864,6 +899,9 @@ def _run_surface(args):
              f"--face-resolution must be > 0 (got {args.face_resolution})")
     _require(args.exemplar_scale > 0, f"--exemplar-scale must be > 0 (got {args.exemplar_scale})")
     _require(1 <= args.segments <= 32, f"--segments must be in 1..32 (got {args.segments})")
+    if args.face_resolution is not None:
+        top = _native.SURFACE_MAX_FACE_RESOLUTION
+        _require(args.face_resolution <= top, f"--face-resolution must be in 1..{top} (got {args.face_resolution})")
     _require(any(args.axis) and all(np.isfinite(args.axis)), "--axis must be a finite, non-zero direction")
 
     objects = import_mesh(mesh_path)
@@ -875,10 +913,7 @@ def _run_surface(args):
         raise UsageError(f"--mesh: {exc}")
     field = None
     if args.field:
-        field = _load_npy("--field", args.field).astype(np.float64)
-        _require(field.shape == mesh.vertices.shape,
-                 f"--field: {args.field} is {field.shape}; --mesh has {len(mesh.vertices)} vertices: give "
-                 f"({len(mesh.vertices)}, 3)")
+        field = _directions("--field", args.field, mesh.vertices, "--mesh")
     colour = image_io.load(exemplar_path)
     height = image_io.load(height_path) if height_path else None
     try:
@@ -925,23 +960,25 @@ def _points_parser(sub):
     out = p.add_mutually_exclusive_group(required=True)
     out.add_argument("--size", type=_finite, nargs=2, metavar=("W", "D"), help="output area, exemplar units")
     out.add_argument("--target", help="a mesh to cover (.obj, .ply, .stl; file coordinates)")
-    p.add_argument("--field-preset", choices=analogy_ops.FIELD_PRESETS, default="around_axis",
+    p.add_argument("--field-preset", choices=analogy_ops.FIELD_PRESETS,
                    help="--target: the direction the texture's x axis follows (default around_axis; the "
                    "presets of 'run analogy')")
-    p.add_argument("--axis", type=_finite, nargs=3, metavar=("X", "Y", "Z"), default=(0.0, 0.0, 1.0),
+    p.add_argument("--axis", type=_finite, nargs=3, metavar=("X", "Y", "Z"),
                    help="around_axis / along_axis: the axis in the file's coordinates (default 0 0 1)")
     p.add_argument("--curve", help="along_curve: the curve as a polyline, .obj (vertices joined by 'l' lines) "
                    "or .npy (N by 3), in the target file's coordinates")
     p.add_argument("--field", help="--target's own field: .npy, one direction per vertex (V by 3, e.g. from "
                    "'run field'); wins over --field-preset")
-    p.add_argument("--scale", type=_finite, default=0.0,
-                   help="--target: target units per exemplar unit (default: 1/8 of the target's longest side)")
-    p.add_argument("--patch-size", type=_finite, default=0.0, help="patch side, exemplar units (default: preset's)")
-    p.add_argument("--density", type=_finite, default=8000.0,
+    p.add_argument("--scale", type=_finite,
+                   help="--target: target units per exemplar unit (default: chosen from the target's area for "
+                   f"about {_native.POINTS_DEFAULT_OUTPUT:.3g} points, about half a minute; the estimate is "
+                   "printed before the work)")
+    p.add_argument("--patch-size", type=_finite, help="patch side, exemplar units (default: preset's)")
+    p.add_argument("--density", type=_finite,
                    help="built-ins and height fields: points per unit area (height fields: per pixel^2 x "
-                   "this / 10000; default 8000)")
-    p.add_argument("--pixel-size", type=_finite, default=1.0, help="height field: units per pixel (default 1)")
-    p.add_argument("--height-scale", type=_finite, default=1.0, help="height field: height of white (default 1)")
+                   f"this / 10000; default {POINTS_DENSITY:g})")
+    p.add_argument("--pixel-size", type=_finite, help="height field: units per pixel (default 1)")
+    p.add_argument("--height-scale", type=_finite, help="height field: height of white (default 1)")
     p.add_argument("--out", required=True, help="the points: .ply (binary, with normals) or .obj (v + vn)")
     p.add_argument("--mesh-out", help="also a surface made from the points: .obj")
     p.add_argument("--seed", type=_seed, default=0, help="random seed (default 0)")
@@ -952,43 +989,80 @@ def _points_parser(sub):
 def _points_exemplar(args, points_ops):
     from .io import point_files
 
+    point_file = bool(args.exemplar) and os.path.splitext(args.exemplar)[1].lower() in (".ply", ".xyz", ".pwn")
+    _require(not point_file or args.density is None,
+             "--density goes with --preset or a height-field image; a point file's points are used as they are")
+    for flag, value in (("--pixel-size", args.pixel_size), ("--height-scale", args.height_scale)):
+        _require(value is None or (args.exemplar and not point_file),
+                 f"{flag} goes with a height-field image as --exemplar (a grey .png)")
+    density = POINTS_DENSITY if args.density is None else args.density
+    _require(density > 0, f"--density must be > 0 points per unit area (got {density:g})")
     if args.preset:
-        _require(args.density > 0, f"--density must be > 0 (got {args.density})")
-        return points_ops.Exemplar(name=args.preset, preset=args.preset, density=args.density), args.preset
+        return points_ops.Exemplar(name=args.preset, preset=args.preset, density=density), args.preset
     path = _input_file("--exemplar", args.exemplar, None)
     name = os.path.splitext(os.path.basename(path))[0]
-    if os.path.splitext(path)[1].lower() in (".ply", ".xyz", ".pwn"):
+    if point_file:
         try:
             pos, nrm = point_files.read_points(path)
         except point_files.PointFileError as exc:
             raise UsageError(f"--exemplar: {exc}")
         return points_ops.Exemplar(name=name, positions=pos, normals=nrm), "default"
-    _require(args.pixel_size > 0, f"--pixel-size must be > 0 (got {args.pixel_size})")
+    pixel_size = 1.0 if args.pixel_size is None else args.pixel_size
+    height_scale = 1.0 if args.height_scale is None else args.height_scale
+    _require(pixel_size > 0, f"--pixel-size must be > 0 (got {pixel_size:g})")
     image = image_io.load(path)
     try:
         grey = image_io.exemplar_pixels(image, role="height field")[::-1, :, 0]  # row 0 = y 0
     finally:
         bpy.data.images.remove(image)
-    heights = np.ascontiguousarray(grey * args.height_scale, np.float32)
+    heights = np.ascontiguousarray(grey * height_scale, np.float32)
+    _require(bool(np.isfinite(heights).all()), f"--height-scale {height_scale:g} makes the heights overflow")
     pad = max(2, min(heights.shape) // 8)
-    ex = _native.height_field_exemplar(heights, pixel_size=args.pixel_size, padding=pad, seed=args.seed,
-                                       density=args.density / 10000.0 / args.pixel_size ** 2)
+    try:
+        ex = _native.height_field_exemplar(heights, pixel_size=pixel_size, padding=pad, seed=args.seed,
+                                           density=density / 10000.0 / pixel_size ** 2)
+    except _native.OverBudgetError as exc:
+        raise UsageError(f"--exemplar {os.path.basename(path)} as a height field at --height-scale "
+                         f"{height_scale:g}, --pixel-size {pixel_size:g}, --density {density:g}: {exc}") from None
     lo, hi = np.array(ex["box_min"]), np.array(ex["box_max"])
     exemplar = points_ops.Exemplar(name=name, positions=ex["positions"] - np.r_[lo, 0.0], normals=ex["normals"])
     exemplar.box = ((0.0, 0.0), tuple(hi - lo))
     return exemplar, "default"
 
 
-def _points_field(path, vertices):
-    """--field for a points target: V by 3 directions (zero rows are left to the engine's projection)."""
-    vectors = _load_npy("--field", path).astype(np.float64)
-    _require(vectors.shape == vertices.shape,
-             f"--field: {path} is {vectors.shape}; --target has {len(vertices)} vertices: give "
-             f"({len(vertices)}, 3), one direction per vertex (e.g. './exsynth run field --mesh' on the same file)")
-    _require(bool(np.isfinite(vectors).all()), f"--field: {path} has NaN or infinite values; fix or regenerate it")
-    _require(bool((np.linalg.norm(vectors, axis=1) > 0).any()),
-             f"--field: {path} is zero everywhere, so it gives the texture no direction")
-    return np.ascontiguousarray(vectors)
+def _points_options(args, exemplar, preset):
+    """The engine options: the preset's, with --patch-size or one fitted to a given exemplar's box."""
+    options = _native.point_texture_preset(preset)
+    if args.patch_size is not None:
+        options["patch_size"] = args.patch_size
+    elif preset == "default" and exemplar.box is None and exemplar.positions is not None:
+        from .operators.points import user_box
+
+        lo, hi = user_box(exemplar.positions)
+        _require(min(np.subtract(hi, lo)) > 0, f"--exemplar: the points of {args.exemplar} span no area in x and y "
+                 "(one point, or all on one line or spot); give an oriented point set spread over a surface")
+        options["patch_size"] = 0.35 * float(min(np.subtract(hi, lo)))
+    elif exemplar.box is not None:
+        options["patch_size"] = 0.35 * float(min(exemplar.box[1]))
+    return options
+
+
+def _points_target(args, exemplar, field_preset, points_ops):
+    """(Target, scale) for --target MESH."""
+    path = _input_file("--target", args.target, MESH_FORMATS)
+    verts, tris = mesh_io.world_triangles(import_mesh(path), bpy.context.evaluated_depsgraph_get())
+    _require(len(tris) > 0, f"--target: {path} has no faces to cover")
+    axis = (0.0, 0.0, 1.0) if args.axis is None else tuple(args.axis)
+    _require(any(axis), "--axis must be a non-zero direction, e.g. --axis 0 0 1")
+    target = points_ops.Target(name=os.path.splitext(os.path.basename(path))[0], vertices=verts, triangles=tris,
+                               preset=field_preset, axis=axis, curve=_read_curve(args.curve) if args.curve else None)
+    if args.field:
+        target.field = np.ascontiguousarray(_directions("--field", args.field, verts, "--target"))
+    try:
+        scale = args.scale or points_ops.default_scale(exemplar, target)
+    except _native.InvalidInputError as exc:
+        raise UsageError(f"--target: {path}: {exc}") from None
+    return target, scale
 
 
 def _run_points(args):
@@ -997,37 +1071,39 @@ def _run_points(args):
 
     out = args.outputs.add("--out", args.out, (".ply", ".obj"))
     mesh_out = args.outputs.add("--mesh-out", args.mesh_out, (".obj",)) if args.mesh_out else None
-    _require(args.patch_size >= 0, f"--patch-size must be > 0 (got {args.patch_size})")
+    on_plane = ("--scale", args.scale), ("--field-preset", args.field_preset), ("--axis", args.axis), \
+        ("--curve", args.curve), ("--field", args.field)
+    for flag, value in on_plane if args.size else ():
+        _require(value is None, f"{flag} goes with --target MESH; over a plane --size gives the output's extent")
+    if args.patch_size is not None:
+        _require(args.patch_size > 0, f"--patch-size must be > 0 exemplar units (got {args.patch_size:g})")
+    if args.scale is not None:
+        _require(args.scale > 0, f"--scale must be > 0 target units per exemplar unit (got {args.scale:g}); leave "
+                 "it out to have it chosen from the target")
     exemplar, preset = _points_exemplar(args, points_ops)
-    options = _native.point_texture_preset(preset)
-    if args.patch_size > 0:
-        options["patch_size"] = args.patch_size
-    elif preset == "default" and getattr(exemplar, "box", None) is None and exemplar.positions is not None:
-        lo, hi = points_ops.user_box(exemplar.positions)
-        options["patch_size"] = 0.35 * float(min(np.subtract(hi, lo)))
-    elif getattr(exemplar, "box", None) is not None:
-        options["patch_size"] = 0.35 * float(min(exemplar.box[1]))
-    job = points_ops.PointTextureJob(exemplar=exemplar, options=options, make_mesh=bool(args.mesh_out),
-                                     memory_budget=int(args.memory_budget * GIB), seed=args.seed)
-    _require(args.target or not (args.curve or args.field), "--curve and --field go with --target MESH")
-    _require(args.field_preset != "along_curve" or args.curve or args.field,
+    job = points_ops.PointTextureJob(exemplar=exemplar, options=_points_options(args, exemplar, preset),
+                                     make_mesh=bool(args.mesh_out), memory_budget=int(args.memory_budget * GIB),
+                                     seed=args.seed)
+    field_preset = args.field_preset or "around_axis"
+    _require(field_preset != "along_curve" or args.curve or args.field,
              "--field-preset along_curve needs --curve CURVE.obj (or .npy)")
-    _require(not args.curve or args.field_preset == "along_curve", "--curve goes with --field-preset along_curve")
+    _require(not args.curve or field_preset == "along_curve", "--curve goes with --field-preset along_curve")
     if args.size:
         _require(min(args.size) > 0, f"--size must be two positive lengths (got {args.size[0]} {args.size[1]})")
         job.size = tuple(args.size)
     else:
-        path = _input_file("--target", args.target, MESH_FORMATS)
-        verts, tris = mesh_io.world_triangles(import_mesh(path), bpy.context.evaluated_depsgraph_get())
-        _require(len(tris) > 0, f"--target: {path} has no faces to cover")
-        _require(any(args.axis) and all(np.isfinite(args.axis)), "--axis must be a finite, non-zero direction")
-        job.target = points_ops.Target(name=os.path.splitext(os.path.basename(path))[0], vertices=verts,
-                                       triangles=tris, preset=args.field_preset, axis=tuple(args.axis),
-                                       curve=_read_curve(args.curve) if args.curve else None)
-        if args.field:
-            job.target.field = _points_field(args.field, verts)
-        longest = float((verts.max(0) - verts.min(0)).max())
-        job.scale = args.scale if args.scale > 0 else longest / 8.0
+        job.target, job.scale = _points_target(args, exemplar, field_preset, points_ops)
+        e = points_ops.estimate(exemplar, job.target, job.scale, job.options)
+        print(f"exsynth points: scale {job.scale:.3g}{'' if args.scale else ' (from the target area)'}: "
+              f"{points_ops.estimate_text(e)}", file=sys.stderr, flush=True)
+        budget = args.memory_budget * GIB or _native.DEFAULT_MEMORY_BUDGET
+        _require(e["bytes"] <= budget,
+                 f"--scale {job.scale:.3g}: about {e['points']:.3g} points need about {e['bytes'] / GIB:.3g} GiB, "
+                 f"over the memory budget of {budget / GIB:.3g} GiB; raise --scale (the default for this target: "
+                 f"{points_ops.default_scale(exemplar, job.target):.3g}) or --memory-budget")
+        if e["seconds"] > 60:
+            print(f"exsynth points: that is long; --scale {job.scale * math.sqrt(e['seconds'] / 30):.3g} makes about "
+                  "half a minute (larger patterns, fewer patches)", file=sys.stderr, flush=True)
     result, seconds = _run_job(job, "points")
     point_files.write_points(out, result.positions, result.normals)
     t = result.stats["times"]

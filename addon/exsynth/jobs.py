@@ -246,6 +246,9 @@ class JobOperator:
         except InputError as exc:
             self.report({'ERROR'}, f"ExSynth {self.bl_label}: {exc}")
             return None
+        preview = job.preview() if hasattr(job, "preview") else None
+        if preview:
+            self.report({'INFO'}, f"ExSynth {self.bl_label}: {preview}")
         return Runner(job)
 
     def _conclude(self, context, runner):

@@ -468,8 +468,9 @@ class ExSynthSettings(bpy.types.PropertyGroup):
         name="Target", description="The mesh to cover (its 'exsynth_field' attribute orients the texture, "
         "otherwise the field preset)", type=bpy.types.Object, poll=lambda self, obj: obj.type == 'MESH',
     )
-    pts_scale: FloatProperty(name="Scale", description="Target units per exemplar unit", default=0.1,
-                             min=1e-4, soft_max=10.0)
+    pts_scale: FloatProperty(name="Scale", description="Target units per exemplar unit; 0 = chosen from the "
+                             "target's area for a job of about half a minute (the panel shows the estimate)",
+                             default=0.0, min=0.0, soft_max=10.0)
     pts_field_preset: EnumProperty(name="Field", description="The direction the texture's x axis follows "
                                    "on a target without an 'exsynth_field' attribute",
                                    items=FIELD_PRESET_ITEMS, default='AROUND_AXIS')

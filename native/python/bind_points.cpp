@@ -289,6 +289,44 @@ void bind_points(py::module_& m) {
       "Grow the point texture over a target mesh (V by 3 vertices, F by 3 faces), its x axis along `field`\n"
       "(V by 3 tangents), `scale` target units per exemplar unit. Same result dict as synthesize_points.");
   m.def(
+      "estimate_points_on_mesh",
+      [](const RealArg& density_arg, const RealArg& area_arg, const RealArg& scale_arg, const py::object& options,
+         const py::kwargs& extra) {
+        reject_unknown(extra, "density, area, scale, options");
+        const double density = real_arg(density_arg, "density", 0.0, kInf, Ends::OpenLow, "exemplar points per unit area");
+        const double area = real_arg(area_arg, "area", 0.0, kInf, Ends::OpenLow, "target surface area");
+        const double scale = real_arg(scale_arg, "scale", 0.0, kInf, Ends::OpenLow, "target units per exemplar unit");
+        const PointTextureEstimate e = estimate_points_on_mesh(density, area, scale, to_options(options, 0, 0));
+        py::dict d;
+        d["patches"] = e.patches;
+        d["points"] = e.points;
+        d["bytes"] = e.bytes;
+        d["seconds"] = e.seconds;
+        return d;
+      },
+      py::arg("density"), py::kw_only(), py::arg("area"), py::arg("scale"), py::arg("options") = py::none(),
+      "What synthesize_points_on_mesh makes, before any work: {'patches', 'points', 'bytes', 'seconds'} for an\n"
+      "exemplar of `density` points per unit of its box over a target of surface `area` at `scale`.");
+  m.def(
+      "default_points_scale",
+      [](const RealArg& density_arg, const RealArg& area_arg, const py::kwargs& extra) {
+        reject_unknown(extra, "density, area");
+        return default_points_scale(real_arg(density_arg, "density", 0.0, kInf, Ends::OpenLow, "points per unit area"),
+                                    real_arg(area_arg, "area", 0.0, kInf, Ends::OpenLow, "target surface area"));
+      },
+      py::arg("density"), py::kw_only(), py::arg("area"),
+      "The scale giving about POINTS_DEFAULT_OUTPUT points over a target of surface `area`.");
+  m.def(
+      "point_exemplar_surface_ratio",
+      [](const StrArg& name, const py::kwargs& extra) {
+        reject_unknown(extra, "name");
+        return point_exemplar_surface_ratio(string_arg(name, "name", "bumps, chainmail, weave or flowers"));
+      },
+      py::arg("name"), "A built-in exemplar's surface area per unit of its box: its points per box area / density.");
+  m.attr("POINTS_DEFAULT_OUTPUT") = kDefaultPointsOnMesh;
+  m.attr("POINTS_SECONDS_PER_POINT") = kPointSecondsPerPoint;
+
+  m.def(
       "points_to_mesh",
       [](const ArrayArg& positions, const OptionalArrayArg& normals, const RealArg& spacing_arg,
          const RealArg& radius_arg, const RealArg& voxel_arg, const IntArg& smoothing_arg, const IntArg& budget_arg,

@@ -132,6 +132,7 @@ py::array flatten(const std::vector<Eigen::Matrix<T, N, 1>>& v) {
 }  // namespace
 
 void bind_surface(py::module_& m) {
+  m.attr("SURFACE_MAX_FACE_RESOLUTION") = SurfaceSynthesisOptions{}.max_face_resolution;
   m.def(
       "texture_surface",
       [](const ArrayArg& vertices, const ArrayArg& face_sizes, const ArrayArg& face_vertices,

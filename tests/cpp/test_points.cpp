@@ -4,10 +4,12 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <random>
 
 
 #include "exsynth/errors.hpp"
+#include "exsynth/memory_budget.hpp"
 #include "exsynth/points.hpp"
 #include "points/pairing.hpp"
 #include "points/patch_solver.hpp"
@@ -421,4 +423,80 @@ TEST(PointTextureOnMesh, EveryStageCancels) {
   const PointTextureOptions o = small_options();
   exsynth::testing::expect_every_stage_cancels(
       [&](ExecContext* ctx) { synthesize_points_on_mesh(ex, sphere, around, 1.0, o, ctx); }, 4);
+}
+
+TEST(PointTextureOnMesh, TheEstimateIsNearWhatTheSynthesisMakes) {
+  // A 9 x 9 plane under a height-field exemplar: the estimate before any work
+  // against the real run's patches and points.
+  const int n = 48;
+  std::vector<float> h(std::size_t(n) * n);
+  for (int r = 0; r < n; ++r)
+    for (int c = 0; c < n; ++c) h[std::size_t(r) * n + c] = float(0.05 * std::sin(2 * 3.14159265 * c / 8.0));
+  const PointExemplar ex = height_field_exemplar(h, n, n, 0.0625, 400.0, 8, 0);
+  const TriangleMesh plane = exsynth::testing::icosphere(2.0f, 3);
+  std::vector<V3> around(plane.vertices.size());
+  for (std::size_t i = 0; i < around.size(); ++i) around[i] = V3::UnitZ().cross(plane.vertices[i]);
+  PointTextureOptions o;
+  o.patch_size = 1.0;
+  o.grid_resolution = 8;
+  std::size_t inside = 0;
+  for (const V3& p : ex.points.positions)
+    inside += p.x() >= ex.box_min.x() && p.x() <= ex.box_max.x() && p.y() >= ex.box_min.y() && p.y() <= ex.box_max.y();
+  const double density = double(inside) / ((ex.box_max - ex.box_min).prod());
+  const double area = points::surface_area(plane), scale = 1.0;
+  const PointTextureEstimate e = estimate_points_on_mesh(density, area, scale, o);
+  const PointTextureResult r = synthesize_points_on_mesh(ex, plane, around, scale, o);
+  EXPECT_GT(double(r.patches), 0.6 * e.patches);
+  EXPECT_LT(double(r.patches), 1.4 * e.patches);
+  EXPECT_GT(double(r.points.size()), 0.6 * e.points);
+  EXPECT_LT(double(r.points.size()), 1.4 * e.points);
+  EXPECT_DOUBLE_EQ(e.seconds, e.points * kPointSecondsPerPoint);
+  // The default scale gives the default output size, whatever the area.
+  const double s = default_points_scale(density, area);
+  EXPECT_NEAR(estimate_points_on_mesh(density, area, s, o).points, kDefaultPointsOnMesh, 1e-6 * kDefaultPointsOnMesh);
+  EXPECT_THROW(default_points_scale(density, 0.0), InvalidInput);
+}
+
+TEST(PointTextureOnMesh, ImpossibleSizesAreNamedWithoutOverflow) {
+  // A scale of 1e-12 asks for ~1e25 points: refused by the budget with a
+  // saturated count (an int64 conversion here was undefined behaviour).
+  const PointExemplar& ex = bumps_exemplar();
+  const TriangleMesh sphere = exsynth::testing::icosphere(1.0f, 2);
+  std::vector<V3> around(sphere.vertices.size());
+  for (std::size_t i = 0; i < around.size(); ++i) around[i] = V3::UnitZ().cross(sphere.vertices[i]);
+  try {
+    synthesize_points_on_mesh(ex, sphere, around, 1e-12, small_options());
+    FAIL() << "expected OverBudget";
+  } catch (const OverBudget& e) {
+    const std::string m = e.what();
+    EXPECT_NE(m.find("e+"), std::string::npos) << m;
+    EXPECT_EQ(m.find("-9223372036854775808"), std::string::npos) << m;
+    EXPECT_NE(m.find("raise the scale"), std::string::npos) << m;
+  }
+  EXPECT_EQ(format_count(1e30), "1e+30");
+  EXPECT_EQ(format_count(437361.0), "437361");
+  EXPECT_EQ(format_count(std::numeric_limits<double>::infinity()), "infinitely many");
+  EXPECT_EQ(format_bytes(1e40).find("TiB") != std::string::npos, true);
+  // An all-zero field gives no direction.
+  const std::vector<V3> zero(sphere.vertices.size(), V3::Zero());
+  EXPECT_THROW(synthesize_points_on_mesh(ex, sphere, zero, 1.0, small_options()), InvalidInput);
+  // A patch smaller than two point spacings holds no points.
+  PointTextureOptions tiny = small_options();
+  tiny.patch_size = 1e-9;
+  try {
+    synthesize_points(ex, 1.0, 1.0, tiny);
+    FAIL() << "expected InvalidInput";
+  } catch (const InvalidInput& e) {
+    EXPECT_NE(std::string(e.what()).find("less than two of the exemplar's point spacings"), std::string::npos) << e.what();
+  }
+}
+
+TEST(PointsToMesh, ASpacingTooSmallForTheIndexRangeIsRefused) {
+  const OrientedPoints pts = sphere_points(1.0f, 200);
+  try {
+    points_to_mesh(pts, 1e-9);
+    FAIL() << "expected InvalidInput";
+  } catch (const InvalidInput& e) {
+    EXPECT_NE(std::string(e.what()).find("give a spacing of at least"), std::string::npos) << e.what();
+  }
 }

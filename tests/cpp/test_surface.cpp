@@ -818,3 +818,29 @@ TEST(SurfaceErrors, BadSynthesisInputsAreRefusedBeforeAllocating) {
   res.face_resolution = 0;
   EXPECT_THROW(synthesize_surface(s, exsynth::testing::disc_texture(16, 16, 3, 1), res), InvalidInput);
 }
+
+TEST(SurfaceSynthesis, SettingsBeyondTheirLimitsAreRefusedNotClamped) {
+  const PolygonMesh m = flat_grid(4);
+  const SubdivSurface s(m);
+  const Image ex = exsynth::testing::disc_texture(40, 40, 3, 5);
+  const auto message = [&](const SurfaceSynthesisOptions& o) {
+    try {
+      synthesize_surface(s, ex, o);
+    } catch (const InvalidInput& e) {
+      return std::string(e.what());
+    }
+    return std::string("accepted");
+  };
+  SurfaceSynthesisOptions o = small_options(SurfaceMethod::Coherent);
+  o.texels_per_unit = 1e12;  // was clamped to 512 texels a face edge, silently
+  EXPECT_NE(message(o).find("over max_face_resolution 512; give texels_per_unit at most"), std::string::npos)
+      << message(o);
+  o = small_options(SurfaceMethod::Coherent);
+  o.exemplar_scale = 1e9;  // 40 px / 5 px neighbourhood: at most 8
+  EXPECT_NE(message(o).find("give exemplar_scale at most 8"), std::string::npos) << message(o);
+  o.exemplar_scale = 8;
+  EXPECT_EQ(message(o), "accepted");
+  o = small_options(SurfaceMethod::Coherent);
+  o.field = constant_field(m.vertices.size(), V3::Zero());
+  EXPECT_NE(message(o).find("field is zero everywhere"), std::string::npos) << message(o);
+}

@@ -114,8 +114,14 @@ FUNCTIONS = {
     "synthesize_points": (call("synthesize_points", PTS, DIRS), {
         "memory_budget": "budget", "seed": "seed", "ctx": "ctx"}),
     "synthesize_points_on_mesh": (call("synthesize_points_on_mesh", PTS, DIRS, VERTS, FACES,
-                                       field=np.zeros_like(VERTS)), {
+                                       field=np.ones_like(VERTS)), {
         "scale": ("real", 0, None), "memory_budget": "budget", "seed": "seed", "ctx": "ctx"}),
+    "estimate_points_on_mesh": (call("estimate_points_on_mesh", density=1000.0, area=2.0, scale=0.5), {
+        "density": ("real", 0, None), "area": ("real", 0, None), "scale": ("real", 0, None)}),
+    "default_points_scale": (call("default_points_scale", density=1000.0, area=2.0), {
+        "density": ("real", 0, None), "area": ("real", 0, None)}),
+    "point_exemplar_surface_ratio": (
+        lambda **over: _native.point_exemplar_surface_ratio(**{"name": "chainmail", **over}), {"name": "str"}),
     "points_to_mesh": (call("points_to_mesh", PTS, DIRS), {
         "spacing": ("real", None, None), "radius": ("real", 0, None), "voxel": ("real", 0, None),
         "smoothing": ("int", 0, 64), "memory_budget": "budget", "ctx": "ctx"}),

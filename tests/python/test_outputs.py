@@ -74,3 +74,54 @@ def test_the_same_path_twice_is_refused(tmp_path):
         with OutputFiles() as files:
             files.add("--out", str(tmp_path / "a.obj"), (".obj",))
             files.add("--mesh-out", str(tmp_path / "a.obj"), (".obj",))
+
+
+def _three_outputs(tmp_path, files):
+    """Declares a.obj, a.mtl and t.png (as `run surface` does) and writes new contents."""
+    temps = [files.add(opt, str(tmp_path / name), (os.path.splitext(name)[1],))
+             for opt, name in (("--out", "a.obj"), ("--out (its .mtl)", "a.mtl"), ("--texture-out", "t.png"))]
+    for temp in temps:
+        with open(temp, "w") as f:
+            f.write("new")
+
+
+def test_a_rename_that_fails_puts_every_file_back(tmp_path):
+    """All or none even when the last rename fails: the first two new files
+    are taken out again and the old ones put back, under the user's names."""
+    for name in ("a.obj", "a.mtl", "t.png"):
+        (tmp_path / name).write_text("old " + name)
+    with pytest.raises(OSError, match=r"--texture-out: cannot replace .*t\.png \(Is a directory\)") as info:
+        with OutputFiles() as files:
+            _three_outputs(tmp_path, files)
+            (tmp_path / "t.png").unlink()
+            (tmp_path / "t.png").mkdir()  # appears after the check: os.rename onto it fails
+    assert ".exsynth-" not in str(info.value)  # the user's path, not the temporary one
+    assert (tmp_path / "a.obj").read_text() == "old a.obj"
+    assert (tmp_path / "a.mtl").read_text() == "old a.mtl"
+    assert sorted(os.listdir(tmp_path)) == ["a.mtl", "a.obj", "t.png"]  # no temporary or moved-aside file
+
+
+def test_replacing_existing_files_keeps_no_old_copy(tmp_path):
+    for name in ("a.obj", "a.mtl", "t.png"):
+        (tmp_path / name).write_text("old")
+    with OutputFiles() as files:
+        _three_outputs(tmp_path, files)
+    assert sorted(os.listdir(tmp_path)) == ["a.mtl", "a.obj", "t.png"]
+    assert all((tmp_path / n).read_text() == "new" for n in ("a.obj", "a.mtl", "t.png"))
+
+
+@pytest.mark.skipif(os.geteuid() != 0, reason="chattr +i needs root (CAP_LINUX_IMMUTABLE)")
+def test_an_immutable_existing_output_is_refused_before_the_job(tmp_path):
+    import subprocess
+
+    png = tmp_path / "t.png"
+    png.write_text("old")
+    subprocess.run(["chattr", "+i", str(png)], check=True)
+    try:
+        with pytest.raises(OutputPathError, match=r"--texture-out: .*t\.png exists and cannot be replaced "
+                                                  r"\(it is marked immutable"):
+            with OutputFiles() as files:
+                _three_outputs(tmp_path, files)
+        assert sorted(os.listdir(tmp_path)) == ["t.png"] and png.read_text() == "old"
+    finally:
+        subprocess.run(["chattr", "-i", str(png)], check=True)

@@ -191,3 +191,42 @@ def test_points_to_mesh_of_a_sphere():
     np.testing.assert_allclose(np.linalg.norm(verts, axis=1), 1.0, atol=0.04)
     with pytest.raises(_native.InvalidInputError, match="oriented"):
         _native.points_to_mesh(p, None)
+
+
+def _area(verts, faces):
+    a, b, c = (verts[faces[:, k]] for k in range(3))
+    return 0.5 * float(np.linalg.norm(np.cross(b - a, c - a), axis=1).sum())
+
+
+@pytest.mark.parametrize("preset", ["bumps", "chainmail"])
+def test_the_estimate_before_the_work_is_near_the_result(preset):
+    """The estimate the CLI and the panel show, against a real run on a sphere,
+    from the built-in's surface ratio (no exemplar built), as the add-on does."""
+    verts, faces = _uv_sphere(2.0, 24, 12)
+    ex = _native.make_point_exemplar(preset, density=300)
+    density = 300 * _native.point_exemplar_surface_ratio(preset)
+    options = {"patch_size": 0.5, "grid_resolution": 8}
+    e = _native.estimate_points_on_mesh(density, area=_area(verts, faces), scale=1.0, options=options)
+    r = _native.synthesize_points_on_mesh(ex["positions"], ex["normals"], verts, faces,
+                                          field=np.cross([0.0, 0.0, 1.0], verts), scale=1.0, options=options)
+    assert 0.5 * e["points"] < len(r["positions"]) < 1.5 * e["points"], (len(r["positions"]), e)
+    assert 0.6 * e["patches"] < r["patches"] < 1.4 * e["patches"], (r["patches"], e)
+    assert e["seconds"] == pytest.approx(e["points"] * _native.POINTS_SECONDS_PER_POINT)
+    s = _native.default_points_scale(density, area=_area(verts, faces))
+    assert _native.estimate_points_on_mesh(density, area=_area(verts, faces), scale=s)["points"] == pytest.approx(
+        _native.POINTS_DEFAULT_OUTPUT)
+
+
+def test_values_out_of_reach_are_refused_by_name(bumps):
+    verts, faces = _uv_sphere(1.0, 12, 6)
+    args = (bumps["positions"], bumps["normals"], verts, faces)
+    with pytest.raises(_native.InvalidInputError, match="the direction field is zero everywhere"):
+        _native.synthesize_points_on_mesh(*args, field=np.zeros_like(verts), options=SMALL)
+    with pytest.raises(_native.OverBudgetError, match=r"about \d\.\de\+\d+ points .*raise the scale"):
+        _native.synthesize_points_on_mesh(*args, field=np.cross([0.0, 0.0, 1.0], verts), scale=1e-12, options=SMALL)
+    with pytest.raises(_native.InvalidInputError, match="less than two of the exemplar's point spacings"):
+        _native.synthesize_points(bumps["positions"], bumps["normals"], options={**SMALL, "patch_size": 1e-9})
+    pts = np.random.default_rng(0).normal(size=(200, 3))
+    pts /= np.linalg.norm(pts, axis=1)[:, None]
+    with pytest.raises(_native.InvalidInputError, match="give a spacing of at least"):  # not OpenVDB's ArithmeticError
+        _native.points_to_mesh(pts, pts, spacing=1e-9)

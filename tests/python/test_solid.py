@@ -119,7 +119,7 @@ def test_image_synthesis_tileable():
     ({"exemplar": np.zeros((1, 1, 3), np.uint8)}, _native.InvalidInputError, ["smaller than the 8x8"]),
     # Turned, the windows must fit in one turn of the central square (6 x 6 here).
     ({"exemplar": np.zeros((6, 10, 3), np.uint8), "rotate_exemplar": "on"}, _native.InvalidInputError,
-     ["exemplar of 6x6 pixels (its central square, turned for rotate_exemplar)", "smaller than the 8x8"]),
+     ["its central square 6x6, turned for rotate_exemplar) is 6x6", "smaller than the 8x8"]),
     ({"exemplar": np.full((32, 32, 3), np.nan, np.float32)}, _native.InvalidInputError, ["non-finite"]),
     ({"exemplar": np.zeros((32, 32, 3), np.int8)}, _native.InvalidInputError, ["'exemplar'", "uint8"]),
     ({"exemplar": np.zeros((32,), np.uint8)}, _native.InvalidInputError, ["'exemplar'", "(H, W)"]),

@@ -304,6 +304,11 @@ def check_settings(preset, resolution, pattern_scale, options=None, names=PANEL_
         for engine_name, user_name in names.items():
             message = message.replace(engine_name, user_name)
         raise InputError(message) from None
+    lowest = math.ceil(PAIR_MIN / PATTERN_SCALE_MAX)
+    if resolution < lowest:
+        raise InputError(f"Resolution {resolution} is too coarse for a built-in pair: even at the largest Pattern "
+                         f"Size ({PATTERN_SCALE_MAX:g}) the pair would be under {PAIR_MIN} voxels across; give a "
+                         f"Resolution of at least {lowest}")
     if pattern_scale is None:
         return  # fitted to the model: fitted_pattern_scale keeps it in range
     r_pair = pair_resolution(resolution, pattern_scale)

@@ -10,8 +10,12 @@ namespace exsynth {
 
 constexpr std::size_t kDefaultMemoryBudget = std::size_t(8) << 30;  // 8 GiB
 
-/// "1.50 GiB", "12.0 MiB", ... for messages.
+/// "1.50 GiB", "12.0 MiB", ... for messages; any double (huge: "3.2e+21 TiB").
 std::string format_bytes(double bytes);
+
+/// A count for messages, computed in floating point so it saturates instead
+/// of overflowing: "437361", "2.4e+19" (from 1e15 up), "infinitely many".
+std::string format_count(double count);
 
 /// Throws OverBudget when `bytes_needed` > `budget` (0 = kDefaultMemoryBudget).
 /// `job` names the work ("voxelize at 2048 voxels"), `advice` what to change.

@@ -110,6 +110,34 @@ PointTextureResult synthesize_points_on_mesh(const PointExemplar& exemplar, cons
                                              const std::vector<Eigen::Vector3f>& field, double scale,
                                              const PointTextureOptions& opt = {}, ExecContext* ctx = nullptr);
 
+/// What synthesize_points_on_mesh makes, estimated before any work from
+/// the exemplar's density (points per unit of its box), the target's surface
+/// area and the scale; its memory check uses the same figures.
+struct PointTextureEstimate {
+  double patches = 0;  ///< patch centres: Poisson-disk, 0.42 patch sides apart
+  double points = 0;   ///< output points (measured: 0.8-1.0 of this)
+  double bytes = 0;    ///< peak memory of the synthesis
+  double seconds = 0;  ///< at kPointSecondsPerPoint
+};
+
+/// Seconds per output point on the 2-core machine the benchmarks run on
+/// (chainmail and bumps on a cube and the bunny: 80-115 microseconds).
+constexpr double kPointSecondsPerPoint = 1.1e-4;
+/// The default scale aims at this many output points (about 30 s there).
+constexpr double kDefaultPointsOnMesh = 250000;
+
+PointTextureEstimate estimate_points_on_mesh(double exemplar_density, double target_area, double scale,
+                                             const PointTextureOptions& opt);
+
+/// The scale (target units per exemplar unit) giving about
+/// kDefaultPointsOnMesh points over `target_area`. Throws InvalidInput if
+/// either figure is not a positive number.
+double default_points_scale(double exemplar_density, double target_area);
+
+/// A built-in exemplar's surface area per unit of box area (chainmail about
+/// 2.9): its points per unit of box area are its density times this.
+double point_exemplar_surface_ratio(const std::string& name);
+
 /// Checks positions/normals (same count, finite, unit normals within 1e-2,
 /// non-empty, points inside the box); throws InvalidInput naming `what`.
 void validate_exemplar(const PointExemplar& exemplar, const char* what = "exemplar");

@@ -1,5 +1,6 @@
 #include "exsynth/memory_budget.hpp"
 
+#include <cmath>
 #include <cstdio>
 
 #include "exsynth/errors.hpp"
@@ -7,14 +8,22 @@
 namespace exsynth {
 
 std::string format_bytes(double bytes) {
+  if (!std::isfinite(bytes)) return "unboundedly many bytes";
   const char* units[] = {"B", "KiB", "MiB", "GiB", "TiB"};
   int u = 0;
   while (bytes >= 1024.0 && u < 4) {
     bytes /= 1024.0;
     ++u;
   }
-  char buf[32];
-  std::snprintf(buf, sizeof buf, u == 0 ? "%.0f %s" : "%.2f %s", bytes, units[u]);
+  char buf[48];
+  std::snprintf(buf, sizeof buf, u == 0 ? "%.0f %s" : bytes < 1e6 ? "%.2f %s" : "%.2g %s", bytes, units[u]);
+  return buf;
+}
+
+std::string format_count(double count) {
+  if (!std::isfinite(count)) return "infinitely many";
+  char buf[48];
+  std::snprintf(buf, sizeof buf, count < 1e15 ? "%.0f" : "%.2g", count);
   return buf;
 }
 

@@ -4,6 +4,7 @@
 // evenly (sample_surface). Also user exemplars from meshes and height fields.
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <functional>
 
 #include <Eigen/Geometry>
@@ -160,6 +161,14 @@ TriangleMesh flowers_mesh(double lo, double hi, std::uint64_t seed) {
   return m;
 }
 
+TriangleMesh builtin_mesh(const std::string& name, double lo, double hi, std::uint64_t seed) {
+  if (name == "bumps") return bumps_mesh(lo, hi, seed);
+  if (name == "chainmail") return chainmail_mesh(lo, hi);
+  if (name == "weave") return weave_mesh(lo, hi);
+  if (name == "flowers") return flowers_mesh(lo, hi, seed);
+  throw InvalidInput("unknown built-in geometry texture '" + name + "'; choose bumps, chainmail, weave or flowers");
+}
+
 void check_density(double density, const char* what) {
   if (!(density > 0) || !std::isfinite(density))
     throw InvalidInput(std::string(what) + ": the density must be a positive number of points per unit area");
@@ -172,10 +181,18 @@ OrientedPoints sample_mesh_points(const TriangleMesh& mesh, double density, std:
   check_density(density, "sample_mesh_points");
   validate_mesh(mesh, "mesh to sample");
   const double count = points::surface_area(mesh) * density;
-  check_memory_budget(count * 3 * 200.0, memory_budget, "sampling " + std::to_string(std::llround(count)) + " points",
-                      "lower the density");
+  char figures[96];
+  std::snprintf(figures, sizeof figures, " (%.3g units² of surface at %.3g points per unit²)",
+                points::surface_area(mesh), density);
+  check_memory_budget(count * 3 * 200.0, memory_budget, "sampling " + format_count(count) + " points" + figures,
+                      "lower the density or the surface's size (for a height field: its heights)");
   if (count < 1) throw InvalidInput("the mesh to sample would get no point at this density; raise the density");
   return points::sample_surface(mesh, std::size_t(std::llround(count)), seed, ctx).points;
+}
+
+double point_exemplar_surface_ratio(const std::string& name) {
+  const double lo = -0.35, hi = 1.35;  // make_point_exemplar's default padding
+  return points::surface_area(builtin_mesh(name, lo, hi, 0)) / ((hi - lo) * (hi - lo));
 }
 
 PointExemplar make_point_exemplar(const std::string& name, double density, double padding, std::uint64_t seed,
@@ -183,17 +200,7 @@ PointExemplar make_point_exemplar(const std::string& name, double density, doubl
   check_density(density, "make_point_exemplar");
   if (!(padding >= 0) || padding > 2) throw InvalidInput("make_point_exemplar: padding must be in [0, 2] box units");
   const double lo = -padding, hi = 1.0 + padding;
-  TriangleMesh m;
-  if (name == "bumps")
-    m = bumps_mesh(lo, hi, seed);
-  else if (name == "chainmail")
-    m = chainmail_mesh(lo, hi);
-  else if (name == "weave")
-    m = weave_mesh(lo, hi);
-  else if (name == "flowers")
-    m = flowers_mesh(lo, hi, seed);
-  else
-    throw InvalidInput("unknown built-in geometry texture '" + name + "'; choose bumps, chainmail, weave or flowers");
+  const TriangleMesh m = builtin_mesh(name, lo, hi, seed);
   PointExemplar ex;
   ex.points = sample_mesh_points(m, density, seed, kDefaultMemoryBudget, ctx);
   // Keep the padded square only (tori and tubes reach a little beyond it).

@@ -12,6 +12,7 @@
 #include <tbb/parallel_for.h>
 
 #include "exsynth/errors.hpp"
+#include "exsynth/memory_budget.hpp"
 #include "exsynth/rng.hpp"
 #include "points/pairing.hpp"
 #include "points/tps.hpp"
@@ -73,16 +74,29 @@ PatchSolver::PatchSolver(const PointExemplar& exemplar, const PointTextureOption
   band_ = 2.0 * cell_;
   h_ = opt.bandwidth * spacing_;
 
+  if (patch_ < 2 * spacing_) {
+    char buf[256];
+    std::snprintf(buf, sizeof buf, "the patch size %.3g is less than two of the exemplar's point spacings (%.3g), "
+                  "so a patch would hold almost no points; give a patch size of at least %.3g", patch_, spacing_,
+                  2 * spacing_);
+    throw InvalidInput(buf);
+  }
   Eigen::Vector3f lo = pos[0], hi = pos[0];
   for (const auto& p : pos) {
     lo = lo.cwiseMin(p);
     hi = hi.cwiseMax(p);
   }
   origin_ = Eigen::Vector2d(lo.x(), lo.y());
-  gx_ = int(std::floor((hi.x() - lo.x()) / cell_));
-  gy_ = int(std::floor((hi.y() - lo.y()) / cell_));
+  const double cells_x = std::floor((hi.x() - lo.x()) / cell_), cells_y = std::floor((hi.y() - lo.y()) / cell_);
+  const double cells_z = std::max(1.0, std::ceil((hi.z() - lo.z() + 4 * cell_) / cell_));
+  if (cells_z * cells_x * cells_y * 16.0 > double(opt.memory_budget ? opt.memory_budget : kDefaultMemoryBudget))
+    throw OverBudget("the exemplar's field grid (" + format_count(cells_x) + " x " + format_count(cells_y) + " x " +
+                     format_count(cells_z) + " cells of the patch size / grid_resolution) would be over the memory "
+                     "budget; raise the patch size or lower grid_resolution");
+  gx_ = int(cells_x);
+  gy_ = int(cells_y);
   z0_ = float(lo.z() - 2 * cell_);
-  nz_ = std::max(1, int(std::ceil((hi.z() - lo.z() + 4 * cell_) / cell_)));
+  nz_ = int(cells_z);
   const int mc = int(std::ceil(margin_ / cell_));
   for (int j = mc; j + res_ + mc <= gy_; ++j)
     for (int i = mc; i + res_ + mc <= gx_; ++i) candidates_.push_back({i, j});
@@ -94,9 +108,6 @@ PatchSolver::PatchSolver(const PointExemplar& exemplar, const PointTextureOption
                   patch_, margin_, double(hi.x() - lo.x()), double(hi.y() - lo.y()));
     throw InvalidInput(buf);
   }
-  if (double(nz_) * gx_ * gy_ * 16.0 > double(opt.memory_budget ? opt.memory_budget : kDefaultMemoryBudget))
-    throw OverBudget("the exemplar's field grid would be over the memory budget; raise the patch size or lower "
-                     "grid_resolution");
 
   // The exemplar's field on the whole grid, once.
   std::vector<Eigen::Vector3f> cells(std::size_t(gx_) * gy_ * nz_);

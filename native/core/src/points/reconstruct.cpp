@@ -1,4 +1,5 @@
 // Oriented points -> level set -> mesh (OpenVDB), see points_to_mesh.
+#include <cstdio>
 #include <cmath>
 #include <mutex>
 
@@ -81,6 +82,9 @@ TriangleMesh drop_inner_shells(const TriangleMesh& m) {
 
 }  // namespace
 
+// OpenVDB's index coordinates are 32-bit; keep well inside them.
+constexpr double kMaxIndexSpan = double(1 << 24);
+
 TriangleMesh points_to_mesh(const OrientedPoints& pts, double spacing, const PointMeshOptions& opt, ExecContext* ctx) {
   if (pts.positions.empty()) throw InvalidInput("points_to_mesh: no points to make a surface from");
   if (pts.normals.size() != pts.positions.size())
@@ -97,6 +101,16 @@ TriangleMesh points_to_mesh(const OrientedPoints& pts, double spacing, const Poi
     if (!(spacing > 0)) throw InvalidInput("points_to_mesh: the points all coincide");
   }
   const double h = opt.voxel * spacing, r = opt.radius * spacing;
+  Eigen::AlignedBox3f box;
+  for (const auto& p : pts.positions) box.extend(p);
+  const double extent = double(box.sizes().maxCoeff()) + 2 * r;
+  if (!(extent / h < kMaxIndexSpan)) {  // also a spacing too small for OpenVDB's transform
+    char msg[200];
+    std::snprintf(msg, sizeof msg, "points_to_mesh: a spacing of %.3g makes voxels of %.3g, so the points' extent "
+                  "%.3g spans more than %.0f voxels; give a spacing of at least %.3g (or 0 to measure it)",
+                  spacing, h, extent, kMaxIndexSpan, extent / kMaxIndexSpan / opt.voxel);
+    throw InvalidInput(msg);
+  }
   // Every sphere touches about (2 r / h)^2 surface voxels, with the band a few more.
   const double voxels = double(pts.size()) * std::pow(2 * r / h + 3.0, 2.0) * 3.0;
   check_memory_budget(voxels * 8.0, opt.memory_budget, "a surface of " + std::to_string(pts.size()) + " points",

@@ -3,6 +3,7 @@
 // centres in front order), then crop and density relaxation.
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <chrono>
 #include <limits>
 #include <numeric>
@@ -12,6 +13,7 @@
 #include <tbb/parallel_for.h>
 
 #include "exsynth/errors.hpp"
+#include "exsynth/memory_budget.hpp"
 #include "exsynth/field.hpp"
 #include "exsynth/parallel.hpp"
 #include "exsynth/points.hpp"
@@ -135,7 +137,7 @@ PointTextureResult synthesize_points(const PointExemplar& exemplar, double width
   const int nx = 1 + int(std::ceil(std::max(0.0, width + 2 * E - P) / s));
   const int ny = 1 + int(std::ceil(std::max(0.0, depth + 2 * E - P) / s));
   const double est = result.density * (width + 2 * E) * (depth + 2 * E) * 1.5;
-  check_memory_budget(est * 120.0, opt.memory_budget, "a point texture of about " + std::to_string(std::llround(est)) + " points",
+  check_memory_budget(est * 120.0, opt.memory_budget, "a point texture of about " + format_count(est) + " points",
                       "lower the output size or the exemplar's density");
   points::OutputStore out(float(0.5 * P));
   {
@@ -226,15 +228,21 @@ PointTextureResult synthesize_points_on_mesh(const PointExemplar& exemplar, cons
                        std::to_string(target.vertices.size()) + " vertices of the target; give one per vertex");
   for (const V3& f : field)
     if (!f.allFinite()) throw InvalidInput("the direction field has NaN or infinite vectors");
+  if (std::none_of(field.begin(), field.end(), [](const V3& f) { return f.squaredNorm() > 0; }))
+    throw InvalidInput("the direction field is zero everywhere, so it gives the texture no direction; give a "
+                       "tangent at some vertices (zero ones are filled in from them)");
   if (!(scale > 0) || !std::isfinite(scale))
     throw InvalidInput("the scale (target units per exemplar unit) must be a positive number");
   points::PatchSolver solver(exemplar, opt, ctx);
   PointTextureResult result;
   finish_density(result, exemplar);
   const double area = points::surface_area(target);
-  const double est = result.density * area / (scale * scale) * 1.5;
-  check_memory_budget(est * 160.0, opt.memory_budget, "a point texture of about " + std::to_string(std::llround(est)) + " points",
-                      "lower the target's size relative to the scale, or the exemplar's density");
+  const PointTextureEstimate est = estimate_points_on_mesh(result.density, area, scale, opt);
+  char figures[160];
+  std::snprintf(figures, sizeof figures, " (%.3g units² of target at %.3g target units per exemplar unit, %.3g "
+                "exemplar points per unit²)", area, scale, result.density);
+  check_memory_budget(est.bytes, opt.memory_budget, "a point texture of about " + format_count(est.points) +
+                      " points" + figures, "raise the scale or lower the exemplar's density");
   // The target as a point-set surface, sampled a few times finer than the metric grid.
   const double cell_world = solver.patch() / opt.grid_resolution * scale;
   const std::size_t count = std::size_t(std::clamp(area / (cell_world * cell_world) * 2.0, 2000.0, 400000.0));
@@ -274,6 +282,25 @@ PointTextureResult synthesize_points_on_mesh(const PointExemplar& exemplar, cons
   OrientedPoints alive = alive_points(out);
   result.points = relax(std::move(alive), solver.spacing() * scale, opt.relax_iterations, ctx);
   return with_stats(std::move(result), solver.stats(), t_start);
+}
+
+PointTextureEstimate estimate_points_on_mesh(double exemplar_density, double target_area, double scale,
+                                             const PointTextureOptions& opt) {
+  PointTextureEstimate e;
+  const double centre_gap = 0.42 * opt.patch_size * scale;  // as patch_centres' radius below
+  e.patches = 0.7 * target_area / (centre_gap * centre_gap);  // random close packing of those discs
+  e.points = exemplar_density * target_area / (scale * scale);
+  e.bytes = e.points * 1.5 * 160.0;
+  e.seconds = e.points * kPointSecondsPerPoint;
+  return e;
+}
+
+double default_points_scale(double exemplar_density, double target_area) {
+  if (!(exemplar_density > 0) || !std::isfinite(exemplar_density))
+    throw InvalidInput("the exemplar's density must be a positive number of points per unit area");
+  if (!(target_area > 0) || !std::isfinite(target_area))
+    throw InvalidInput("the target mesh has no surface area (all its faces are degenerate)");
+  return std::sqrt(exemplar_density * target_area / kDefaultPointsOnMesh);
 }
 
 }  // namespace exsynth

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdlib>
 #include <memory>
+#include <array>
 #include <string>
 
 #include "exsynth/errors.hpp"
@@ -133,6 +134,8 @@ struct Job {
 // are reserved up front and never reallocate; so the struct stays put.
 struct PreparedExemplars {
   std::vector<const Image*> images;
+  std::vector<std::string> names;           // per image: "the exemplar for view z", for messages
+  std::vector<std::array<int, 2>> given;    // per image: its size as given (before max_exemplar_size)
   std::array<int, 3> image_of{-1, -1, -1};  // per view: index into images, -1 = inactive
   int user_channels = 0, channels = 0;      // channels counts the feature channel
   int exponent = 0;                         // values were scaled by 2^-exponent
@@ -159,6 +162,8 @@ void distinct_exemplars(const Job& job, PreparedExemplars& p) {
                            std::to_string(job.views[i]->channels()) + "); give every view the same channels");
       channels = job.views[i]->channels();
       p.images.push_back(job.views[i]);
+      p.names.push_back(what);
+      p.given.push_back({job.views[i]->width(), job.views[i]->height()});
       it = p.images.end() - 1;
     }
     p.image_of[i] = int(it - p.images.begin());
@@ -386,9 +391,13 @@ TextureResult optimize_texture(const Job& job, const TextureOptimizationOptions&
     // A turned exemplar's windows must fit in one turn: a quarter of the mosaic.
     const int q = ex.turned[e] ? 2 : 1;
     const Image& coarsest = pyramids.back().back();
+    const auto size = [](int w, int h) { return std::to_string(w) + "x" + std::to_string(h); };
+    const bool reduced = q == 1 && (ex.given[e][0] != img->width() || ex.given[e][1] != img->height());
     if (coarsest.width() / q < n || coarsest.height() / q < n)
-      throw InvalidInput("an exemplar of " + std::to_string(img->width() / q) + "x" + std::to_string(img->height() / q) +
-                         " pixels" + (q > 1 ? std::string(" (its central square, turned for rotate_exemplar)") : "") +
+      throw InvalidInput(ex.names[e] + " (" + size(ex.given[e][0], ex.given[e][1]) + " pixels" +
+                         (reduced ? ", analysed at " + size(img->width(), img->height()) + " within max_exemplar_size" : "") +
+                         (q > 1 ? "; its central square " + size(img->width() / q, img->height() / q) +
+                                      ", turned for rotate_exemplar" : std::string()) + ")" +
                          " is " + std::to_string(coarsest.width() / q) + "x" + std::to_string(coarsest.height() / q) +
                          " at the coarsest of " + std::to_string(L) + " levels, smaller than the " + std::to_string(n) + "x" +
                          std::to_string(n) + " neighbourhood; use a larger exemplar, fewer levels or a smaller neighbourhood");

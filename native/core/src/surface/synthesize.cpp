@@ -1,5 +1,6 @@
 // synthesize_surface: validation, texel budget, frames, then one method.
 #include <algorithm>
+#include <cstdio>
 #include <cmath>
 #include <memory>
 #include <numeric>
@@ -59,6 +60,14 @@ std::vector<int> face_resolutions(const std::vector<double>& areas, const Surfac
       const double side = std::ceil(opt.texels_per_unit * std::sqrt(std::max(areas[f], 0.0)) - 1e-9);
       res[f] = int(std::clamp(side, double(opt.min_face_resolution), double(opt.max_face_resolution)));
     }
+    const double largest = areas.empty() ? 0.0 : std::sqrt(*std::max_element(areas.begin(), areas.end()));
+    if (opt.texels_per_unit * largest > opt.max_face_resolution + 1e-9) {
+      char msg[256];
+      std::snprintf(msg, sizeof msg, "texels_per_unit %.3g asks for %.3g texels along the largest face, over "
+                    "max_face_resolution %d; give texels_per_unit at most %.4g for this mesh", opt.texels_per_unit,
+                    opt.texels_per_unit * largest, opt.max_face_resolution, opt.max_face_resolution / largest);
+      throw InvalidInput(msg);
+    }
   }
   return res;
 }
@@ -86,6 +95,14 @@ SurfaceTexture synthesize_surface(const SubdivSurface& surface, const Image& exe
     throw InvalidInput("exemplar is " + std::to_string(exemplar.width()) + "x" + std::to_string(exemplar.height()) +
                        ", smaller than the " + std::to_string(need) + "x" + std::to_string(need) +
                        " neighbourhood; give a larger image");
+  const int narrow = std::min(exemplar.width(), exemplar.height());
+  if (opt.exemplar_scale > double(narrow) / need) {
+    char msg[256];
+    std::snprintf(msg, sizeof msg, "exemplar_scale %.3g steps so far per texel that the %dx%d neighbourhood spans "
+                  "more than the %dx%d exemplar; give exemplar_scale at most %.3g", opt.exemplar_scale, need, need,
+                  exemplar.width(), exemplar.height(), double(narrow) / need);
+    throw InvalidInput(msg);
+  }
   const std::size_t nv = std::size_t(surface.control_vertex_count());
   if (!opt.field.empty()) {
     if (opt.field.size() != nv)
@@ -93,6 +110,9 @@ SurfaceTexture synthesize_surface(const SubdivSurface& surface, const Image& exe
                          std::to_string(nv) + " vertices; give one vector per vertex");
     for (const auto& v : opt.field)
       if (!v.allFinite()) throw InvalidInput("field has non-finite vectors");
+    if (std::none_of(opt.field.begin(), opt.field.end(), [](const auto& v) { return v.squaredNorm() > 0; }))
+      throw InvalidInput("field is zero everywhere, so it gives the texture no direction; give a tangent at some "
+                         "vertices, or no field for a smooth one");
   }
 
   const std::vector<double> areas = surface.ptex_face_areas();
