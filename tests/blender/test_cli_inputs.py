@@ -64,7 +64,7 @@ def test_a_millionth_sized_model_works(tmp_path, capsys):
     assert 1e-7 < np.ptp(verts, axis=0).max() < 1e-5
     # A .vdb cannot store such voxels: refused with what to do, nothing written.
     code, err = run(capsys, "voxelize", "--mesh", tiny, "--resolution", "16", "--out", str(tmp_path / "t.vdb"))
-    assert code == 1 and "too small for an OpenVDB file" in err and "scale the model up" in err
+    assert code == 2 and "too small for an OpenVDB file" in err and "scale the model up" in err
     assert sorted(os.listdir(tmp_path)) == ["tiny.obj", "x.obj"]
 
 

@@ -161,7 +161,8 @@ def test_solid_feature_weight(tmp_path, capsys):
         assert code == 0, err
     plain, featured = (np.load(p) for p in outs)
     assert plain.shape == featured.shape == (16, 16, 16, 3) and not np.array_equal(plain, featured)
-    for weight, message in (("-1", "--feature-weight must be >= 0 (got -1.0)"), ("101", "feature_weight")):
+    for weight, message in (("-1", "--feature-weight must be >= 0 (got -1.0)"),
+                            ("101", "--feature-weight must be a number in [0, 100]")):
         code, err = run(capsys, "solid", "--exemplar", CRACKED, *FAST_SOLID, "--feature-weight", weight,
                         "--out", str(tmp_path / "bad.npy"))
         assert code != 0 and message in err, err
@@ -212,7 +213,8 @@ def test_solid_rotate_exemplar(tmp_path, capsys):
 
 def test_solid_histogram_values(tmp_path, capsys):
     solid_as_the_engine_makes(tmp_path, capsys, ["--histogram-values", "0.1"], "histogram_values", 0.1, 0.0)
-    for value, message in (("-1", "--histogram-values must be >= 0 (got -1.0)"), ("101", "histogram_values")):
+    for value, message in (("-1", "--histogram-values must be >= 0 (got -1.0)"),
+                           ("101", "--histogram-values must be a number in [0, 100]")):
         refuses(tmp_path, capsys, ["--histogram-values", value], message)
 
 

@@ -254,5 +254,5 @@ def test_cli_bad_arguments(tmp_path, capsys):
     assert cli.main(["field", "--mesh", BUNNY_OBJ, "--paint", str(tmp_path / "bad.npy"), "--out", out]) == 2
     assert "one vector per vertex" in capsys.readouterr().err
     np.save(tmp_path / "zero.npy", np.zeros_like(obj_vertices(BUNNY_OBJ), dtype=np.float32))
-    assert cli.main(["field", "--mesh", BUNNY_OBJ, "--paint", str(tmp_path / "zero.npy"), "--out", out]) == 1
+    assert cli.main(["field", "--mesh", BUNNY_OBJ, "--paint", str(tmp_path / "zero.npy"), "--out", out]) == 2
     assert "no non-zero vectors" in capsys.readouterr().err

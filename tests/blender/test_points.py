@@ -176,7 +176,7 @@ def test_cli_height_field_png_and_target(tmp_path):
 def test_cli_bad_arguments(tmp_path, capsys):
     assert cli.main(["points", "--preset", "bumps", "--size", "1", "1", "--out", str(tmp_path / "x.txt")]) == 2
     assert cli.main(["points", "--preset", "bumps", "--size", "1", "1", "--patch-size", "5",
-                     "--out", str(tmp_path / "x.ply")]) == 1
+                     "--out", str(tmp_path / "x.ply")]) == 2  # the engine's check: a bad argument too
     assert "lower the patch size" in capsys.readouterr().err
     assert not (tmp_path / "x.ply").exists()
 
@@ -217,8 +217,8 @@ def test_cli_field_arguments_that_do_not_fit(tmp_path, capsys):
     cases = [
         (["--target", BUNNY_OBJ, "--field-preset", "along_curve"], "needs --curve"),
         (["--target", BUNNY_OBJ, "--curve", str(curve)], "--curve goes with --field-preset along_curve"),
-        (["--size", "1", "1", "--curve", str(curve), "--field-preset", "along_curve"], "go with --target"),
-        (["--size", "1", "1", "--field", str(nan)], "go with --target"),
+        (["--size", "1", "1", "--curve", str(curve), "--field-preset", "along_curve"], "with --target"),
+        (["--size", "1", "1", "--field", str(nan)], "with --target"),
         (["--target", BUNNY_OBJ, "--field-preset", "along_curve", "--curve", str(tmp_path / "none.npy")], "--curve"),
         (["--target", BUNNY_OBJ, "--field-preset", "sideways"], "invalid choice"),
     ]

@@ -407,7 +407,7 @@ def test_exemplar_smaller_than_the_neighbourhood(cow, exemplar):
     tiny.pixels.foreach_set(np.random.default_rng(0).random(64).astype(np.float32))
     settings().solid_exemplar = tiny
     # The mesh has no UV map: Smart UV Project ran on a copy; the cow stays without.
-    run_expecting_error(r"exemplar of 4x4 pixels.*smaller than the 8x8 neighbourhood", objects=[cow])
+    run_expecting_error(r"exemplar for view x \(4x4 pixels\).*smaller than the 8x8 neighbourhood", objects=[cow])
 
 
 def test_exemplar_without_pixels(cow, exemplar):
@@ -641,9 +641,9 @@ def test_cli_bad_arguments(tmp_path, monkeypatch, capsys):
         (["--exemplar", CRACKED, "--out", "s.npy", "--size", "0"], 2, "--size must be > 0"),
         (["--exemplar", CRACKED, "--out", "s.npy", "--bake-interpolation", "nearest"], 2,
          "--bake-interpolation: invalid choice: 'nearest'"),
-        (["--exemplar", str(tiny), *FAST, "--method", "optimization", "--out", "s.npy"], 1,
+        (["--exemplar", str(tiny), *FAST, "--method", "optimization", "--out", "s.npy"], 2,
          "smaller than the 8x8 neighbourhood"),
-        (["--exemplar", str(tiny), *FAST, "--method", "coordinates", "--out", "s.npy"], 1,
+        (["--exemplar", str(tiny), *FAST, "--method", "coordinates", "--out", "s.npy"], 2,
          "too small for method 'coordinates'"),
     ]
     for args, code, message in cases:
