@@ -134,3 +134,16 @@ def add_faceless_mesh(name="Dots"):
     bpy.context.collection.objects.link(obj)
     bpy.context.view_layer.objects.active = obj
     return obj
+
+
+def write_grid_obj(path, n=3):
+    """An n x n grid of unit quads in z = 0 as OBJ; returns the path."""
+    with open(path, "w") as f:
+        for j in range(n + 1):
+            for i in range(n + 1):
+                f.write(f"v {i} {j} 0\n")
+        for j in range(n):
+            for i in range(n):
+                a = j * (n + 1) + i + 1
+                f.write(f"f {a} {a + 1} {a + n + 2} {a + n + 1}\n")
+    return path

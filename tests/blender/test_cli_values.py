@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 from exsynth import cli
-from helpers import TEXTURES
+from helpers import TEXTURES, write_grid_obj
 
 EXEMPLAR = os.path.join(TEXTURES, "crackedground.png")
 
@@ -23,20 +23,8 @@ def run(capsys, *args):
     return code, captured.err
 
 
-def grid_obj(path, n=2):
-    with open(path, "w") as f:
-        for j in range(n + 1):
-            for i in range(n + 1):
-                f.write(f"v {i} {j} 0\n")
-        for j in range(n):
-            for i in range(n):
-                a = j * (n + 1) + i + 1
-                f.write(f"f {a} {a + 1} {a + n + 2} {a + n + 1}\n")
-    return path
-
-
 def surface(tmp_path, *extra):
-    return ["surface", "--mesh", grid_obj(tmp_path / "plane.obj"), "--exemplar", EXEMPLAR,
+    return ["surface", "--mesh", write_grid_obj(tmp_path / "plane.obj", 2), "--exemplar", EXEMPLAR,
             "--face-resolution", "4", "--out", tmp_path / "a.obj", "--texture-out", tmp_path / "t.png", *extra]
 
 

@@ -11,7 +11,7 @@ import pytest
 
 from exsynth import _native, cli, jobs
 from exsynth.operators import surface as surface_ops
-from helpers import TEXTURES, cancel_once_running, read_obj, scene_state
+from helpers import TEXTURES, cancel_once_running, read_obj, scene_state, write_grid_obj
 
 EXEMPLAR = os.path.join(TEXTURES, "crackedground.png")
 
@@ -206,17 +206,6 @@ def test_cancel_while_running_and_rollback(sphere, exemplar, monkeypatch):
 
 
 # ---- ./exsynth run surface ---------------------------------------------------------
-def write_grid_obj(path, n=3):
-    with open(path, "w") as f:
-        for j in range(n + 1):
-            for i in range(n + 1):
-                f.write(f"v {i} {j} 0\n")
-        for j in range(n):
-            for i in range(n):
-                a = j * (n + 1) + i + 1
-                f.write(f"f {a} {a + 1} {a + n + 2} {a + n + 1}\n")
-
-
 def test_cli_writes_mesh_mtl_and_atlas(tmp_path, capsys):
     mesh = tmp_path / "plane.obj"
     write_grid_obj(mesh)
