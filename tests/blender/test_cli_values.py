@@ -5,13 +5,12 @@ silently, no impossible number in a message, and a job's files appear all
 together or not at all."""
 
 import os
-import subprocess
 
 import numpy as np
 import pytest
 
 from exsynth import cli
-from helpers import TEXTURES, write_grid_obj
+from helpers import TEXTURES, immutable, write_grid_obj
 
 EXEMPLAR = os.path.join(TEXTURES, "crackedground.png")
 
@@ -28,16 +27,13 @@ def surface(tmp_path, *extra):
             "--face-resolution", "4", "--out", tmp_path / "a.obj", "--texture-out", tmp_path / "t.png", *extra]
 
 
-@pytest.mark.skipif(os.geteuid() != 0, reason="chattr +i needs root (CAP_LINUX_IMMUTABLE)")
+@pytest.mark.skipif(os.geteuid() != 0, reason="marking a file immutable needs root (CAP_LINUX_IMMUTABLE)")
 def test_an_immutable_texture_out_is_refused_and_nothing_changes(tmp_path, capsys):
     """The issue's case: the new .obj and .mtl were left beside the old .png."""
     for name in ("a.obj", "a.mtl", "t.png"):
         (tmp_path / name).write_text("old " + name)
-    subprocess.run(["chattr", "+i", str(tmp_path / "t.png")], check=True)
-    try:
+    with immutable(tmp_path / "t.png"):
         code, err = run(capsys, *surface(tmp_path))
-    finally:
-        subprocess.run(["chattr", "-i", str(tmp_path / "t.png")], check=True)
     assert code == 2
     assert f"--texture-out: {tmp_path / 't.png'} exists and cannot be replaced" in err and ".exsynth-" not in err
     assert sorted(os.listdir(tmp_path)) == ["a.mtl", "a.obj", "plane.obj", "t.png"]

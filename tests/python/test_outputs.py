@@ -3,6 +3,7 @@
 import os
 
 import pytest
+from conftest import immutable
 
 from exsynth.io.outputs import OutputFiles, OutputPathError
 
@@ -110,18 +111,13 @@ def test_replacing_existing_files_keeps_no_old_copy(tmp_path):
     assert all((tmp_path / n).read_text() == "new" for n in ("a.obj", "a.mtl", "t.png"))
 
 
-@pytest.mark.skipif(os.geteuid() != 0, reason="chattr +i needs root (CAP_LINUX_IMMUTABLE)")
+@pytest.mark.skipif(os.geteuid() != 0, reason="marking a file immutable needs root (CAP_LINUX_IMMUTABLE)")
 def test_an_immutable_existing_output_is_refused_before_the_job(tmp_path):
-    import subprocess
-
     png = tmp_path / "t.png"
     png.write_text("old")
-    subprocess.run(["chattr", "+i", str(png)], check=True)
-    try:
+    with immutable(png):
         with pytest.raises(OutputPathError, match=r"--texture-out: .*t\.png exists and cannot be replaced "
                                                   r"\(it is marked immutable"):
             with OutputFiles() as files:
                 _three_outputs(tmp_path, files)
         assert sorted(os.listdir(tmp_path)) == ["t.png"] and png.read_text() == "old"
-    finally:
-        subprocess.run(["chattr", "-i", str(png)], check=True)
