@@ -2,9 +2,12 @@
 """Checks on mesh files that Blender's importers hide.
 
 Blender's OBJ and PLY importers silently drop faces whose vertex indices are
-out of range, so a broken file would give a mesh with holes and no word of
-why. The headless jobs read the face indices themselves first (OBJ, ASCII
-PLY; STL has no indices) and refuse such a file, naming the line.
+out of range, and turn a NaN coordinate into some number, so a broken file
+would give a different mesh with no word of why. The headless jobs read the
+files themselves first, whatever the format (OBJ; PLY ascii, binary little-
+and big-endian, through io.ply; STL ascii and binary), and refuse a face
+naming a missing vertex, a vertex that is not finite, or a malformed file,
+naming the option, the file, the line or element, and the fix.
 
 The jobs write their result meshes themselves too (write_obj), at full
 precision. The field job also reads OBJ files itself (read_obj): its output has one
@@ -16,8 +19,13 @@ No bpy here.
 
 import math
 import os
+import struct
 
 import numpy as np
+
+from . import ply
+
+FIX = "fix or re-export the file"
 
 
 class MeshFileError(ValueError):
@@ -25,13 +33,19 @@ class MeshFileError(ValueError):
 
 
 def check_indices(option, path):
-    """Raise MeshFileError if a face of the OBJ or ASCII PLY file names a vertex
-    it does not have, or (OBJ) a vertex is not three finite numbers."""
+    """Raise MeshFileError if the OBJ, PLY or STL file is malformed, a face
+    names a vertex it does not have, or a vertex is not finite. Other
+    extensions (images, .npy) are not looked at."""
     lower = path.lower()
     if lower.endswith(".obj"):
         _check_obj(option, path)
     elif lower.endswith(".ply"):
-        _check_ascii_ply(option, path)
+        _check_ply(option, path)
+    elif lower.endswith(".stl"):
+        _check_stl(option, path)
+
+
+check_mesh_file = check_indices
 
 
 def _check_obj(option, path):
@@ -63,37 +77,91 @@ def _check_obj(option, path):
                             f"{vertices} vertices before that line); fix or re-export the file")
 
 
-def _check_ascii_ply(option, path):
+def _check_ply(option, path):
+    try:
+        data = ply.read(path)
+    except ply.PlyError as exc:
+        raise MeshFileError(f"{option}: {path}: {exc}") from None
+    vertex = data.data.get("vertex")
+    if vertex is None or not all(c in vertex and not isinstance(vertex[c], ply.List) for c in "xyz"):
+        raise MeshFileError(f"{option}: {path}: the PLY file has no vertex element with x y z; {FIX}")
+    xyz = np.stack([np.asarray(vertex[c], np.float64) for c in "xyz"], axis=1)
+    finite = np.isfinite(xyz).all(axis=1)
+    if not finite.all():
+        i = int(np.argmin(finite))
+        raise MeshFileError(f"{_where(option, path, data, 'vertex', i)}: vertex {i} is not finite "
+                            f"({' '.join(f'{v:g}' for v in xyz[i])}); remove or fix it")
+    if "face" in data.data:
+        _check_ply_faces(option, path, data, len(xyz))
+
+
+def _check_ply_faces(option, path, data, vertices):
+    faces = data.data["face"]
+    indices = faces.get("vertex_indices", faces.get("vertex_index"))
+    if not isinstance(indices, ply.List) or indices.values.dtype.kind == "f":
+        raise MeshFileError(f"{option}: {path}: the PLY faces have no integer list 'vertex_indices'; {FIX}")
+    values = indices.values.astype(np.int64)
+    bad = (values < 0) | (values >= vertices)
+    if bad.any():
+        k = int(np.argmax(bad))
+        face = int(np.searchsorted(np.cumsum(indices.lengths), k, side="right"))
+        raise MeshFileError(
+            f"{_where(option, path, data, 'face', face)}: face {face} names vertex {values[k]}, which is out of "
+            f"range (the file has {vertices} vertices, numbered from 0); {FIX}")
+
+
+def _where(option, path, data, element, row):
+    """'--mesh: PATH line N' for ASCII PLY, '--mesh: PATH' for binary."""
+    lines = data.lines.get(element)
+    return f"{option}: {path} line {lines[row]}" if lines is not None else f"{option}: {path}"
+
+
+def _check_stl(option, path):
+    size = os.path.getsize(path)
     with open(path, "rb") as f:
-        if f.readline().strip() != b"ply":
-            return
-        header, line_number = [], 1
-        for line in f:
-            line_number += 1
-            header.append(line.split())
-            if line.strip() == b"end_header":
-                break
-        if not any(h[:2] == [b"format", b"ascii"] for h in header):
-            return  # binary PLY: Blender's importer is the only reader
-        elements = [(h[1].decode(), int(h[2])) for h in header if h[:1] == [b"element"]]
-        counts = dict(elements)
-        vertices = counts.get("vertex", 0)
-        for name, count in elements:
-            for _ in range(count):
-                line = f.readline()
-                line_number += 1
-                if name != "face":
-                    continue
+        head = f.read(84)
+    count = struct.unpack("<I", head[80:84])[0] if len(head) == 84 else None
+    if count is not None and size == 84 + 50 * count:
+        rows = np.fromfile(path, np.dtype([("n", "<f4", 3), ("v", "<f4", (3, 3)), ("a", "<u2")]), count, offset=84)
+        finite = np.isfinite(rows["v"]).all(axis=(1, 2))
+        if not finite.all():
+            i = int(np.argmin(finite))
+            raise MeshFileError(f"{option}: {path}: triangle {i} has a vertex that is not finite; remove or fix it")
+    elif head.lstrip().startswith(b"solid"):
+        _check_ascii_stl(option, path, count, size)
+    elif count is None:
+        raise MeshFileError(f"{option}: {path}: {size} bytes is too short for a binary STL file and it is not "
+                            f"an ASCII STL (it does not start with 'solid'); {FIX}")
+    else:
+        raise MeshFileError(f"{option}: {path}: a binary STL of {count} triangles has {84 + 50 * count} bytes, "
+                            f"the file has {size}: it is cut short or its header is wrong; {FIX}")
+
+
+def _check_ascii_stl(option, path, count, size):
+    corners, triangles, number = None, 0, 0
+    with open(path, "rb") as f:
+        for number, line in enumerate(f, 1):
+            words = line.split()
+            key = words[0] if words else b""
+            if key == b"outer":
+                corners = 0
+            elif key == b"vertex":
                 try:
-                    values = [int(t) for t in line.split()]
+                    finite = len(words) == 4 and all(math.isfinite(float(t)) for t in words[1:])
                 except ValueError:
-                    raise MeshFileError(f"{option}: {path} line {line_number}: a face must be a list of vertex "
-                                        "indices") from None
-                for index in values[1:1 + values[0]] if values else []:
-                    if not 0 <= index < vertices:
-                        raise MeshFileError(
-                            f"{option}: {path} line {line_number}: face vertex {index} is out of range (the file "
-                            f"has {vertices} vertices, numbered from 0); fix or re-export the file")
+                    finite = False
+                if not finite:
+                    raise MeshFileError(f"{option}: {path} line {number}: a vertex is not three finite numbers; "
+                                        "remove or fix it")
+                corners = (corners or 0) + 1
+            elif key == b"endloop":
+                if corners != 3:
+                    raise MeshFileError(f"{option}: {path} line {number}: a facet has {corners or 0} vertices; an "
+                                        f"STL facet is a triangle of three; {FIX}")
+                triangles += 1
+    if triangles == 0:
+        also = f" nor a binary STL (that would be {84 + 50 * count} bytes, not {size})" if count is not None else ""
+        raise MeshFileError(f"{option}: {path}: no triangles as an ASCII STL{also}; {FIX}")
 
 
 def read_obj(option, path):

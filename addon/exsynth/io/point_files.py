@@ -1,19 +1,31 @@
 # SPDX-License-Identifier: GPL-3.0-or-later
-"""Oriented point files (no bpy): read .ply (ASCII or binary little-endian,
+"""Oriented point files (no bpy): read .ply (ASCII or binary, through io.ply,
 vertex x y z nx ny nz), .xyz / .pwn (text, six numbers a line); write .ply
-(binary) and .obj (v and vn lines)."""
+(binary) and .obj (v and vn lines). A mesh (.obj, .stl, a .ply without
+normals) is refused with what to give instead.
+
+Messages start with the file's path (the CLI puts the option in front)."""
 
 import os
 
 import numpy as np
 
-_PLY_TYPES = {"char": "i1", "uchar": "u1", "int8": "i1", "uint8": "u1", "short": "i2", "ushort": "u2",
-              "int16": "i2", "uint16": "u2", "int": "i4", "uint": "u4", "int32": "i4", "uint32": "u4",
-              "float": "f4", "float32": "f4", "double": "f8", "float64": "f8"}
+from . import ply
+
+POINT_EXTENSIONS = (".ply", ".xyz", ".pwn")
+MESH_EXTENSIONS = (".obj", ".stl")
+GIVE = ("give an oriented point set: a .ply with x y z nx ny nz per vertex, or a .xyz / .pwn of six numbers a "
+        "line (x y z nx ny nz)")
 
 
 class PointFileError(ValueError):
     """The file is not an oriented point set we can read; the message says why."""
+
+
+def is_point_file(path):
+    """Whether read_points should read the file: a point file, or a mesh it
+    refuses with a clear message (not an image)."""
+    return os.path.splitext(path)[1].lower() in POINT_EXTENSIONS + MESH_EXTENSIONS
 
 
 def read_points(path):
@@ -22,73 +34,58 @@ def read_points(path):
     if ext == ".ply":
         pos, nrm = _read_ply(path)
     elif ext in (".xyz", ".pwn"):
-        try:
-            data = np.loadtxt(path, ndmin=2)
-        except ValueError as exc:
-            raise PointFileError(f"{path}: not a table of numbers ({exc})")
-        if data.shape[1] < 6:
-            raise PointFileError(f"{path}: {data.shape[1]} numbers a line; an oriented point set needs six "
-                                 "(x y z nx ny nz): the file has no normals")
-        pos, nrm = data[:, :3], data[:, 3:6]
+        pos, nrm = _read_text(path)
+    elif ext in MESH_EXTENSIONS:
+        raise PointFileError(f"{path}: a mesh ({ext}) has no per-point normals, it is not an oriented point set; "
+                             + GIVE)
     else:
         raise PointFileError(f"{path}: unsupported point file '{ext}' (use .ply, .xyz or .pwn)")
     if len(pos) == 0:
-        raise PointFileError(f"{path}: the file holds no points")
+        raise PointFileError(f"{path}: the file holds no points; " + GIVE)
+    finite = np.isfinite(pos).all(axis=1) & np.isfinite(nrm).all(axis=1)
+    if not finite.all():
+        raise PointFileError(f"{path}: point {int(np.argmin(finite))} (of {len(pos)}) has a NaN or infinite "
+                             "position or normal; remove or fix it")
     length = np.linalg.norm(nrm, axis=1)
-    if not np.all(np.isfinite(pos)) or not np.all(np.isfinite(nrm)):
-        raise PointFileError(f"{path}: some positions or normals are NaN or infinite")
     if np.any(length < 1e-8):
-        raise PointFileError(f"{path}: some normals are zero; every point needs a direction")
+        raise PointFileError(f"{path}: point {int(np.argmax(length < 1e-8))} has a zero normal; every point needs "
+                             "a direction")
     return pos.astype(np.float64), (nrm / length[:, None]).astype(np.float64)
 
 
-def _read_ply(path):
+def _read_text(path):
     with open(path, "rb") as f:
-        if f.readline().strip() != b"ply":
-            raise PointFileError(f"{path}: not a PLY file")
-        fmt, elements, current = None, [], None
-        while True:
-            line = f.readline()
-            if not line:
-                raise PointFileError(f"{path}: the PLY header has no end_header")
-            words = line.decode("ascii", "replace").split()
-            if not words:
-                continue
-            if words[0] == "format":
-                fmt = words[1]
-            elif words[0] == "element":
-                current = [words[1], int(words[2]), []]
-                elements.append(current)
-            elif words[0] == "property":
-                if words[1] == "list":
-                    current[2].append((words[4], None, (words[2], words[3])))
-                else:
-                    current[2].append((words[2], _PLY_TYPES[words[1]], None))
-            elif words[0] == "end_header":
-                break
-        if not elements or elements[0][0] != "vertex":
-            raise PointFileError(f"{path}: the PLY file's first element is not 'vertex'")
-        name, count, props = elements[0]
-        names = [p[0] for p in props]
-        if not {"x", "y", "z"} <= set(names):
-            raise PointFileError(f"{path}: the PLY vertices have no x y z")
-        if not {"nx", "ny", "nz"} <= set(names):
-            raise PointFileError(f"{path}: the PLY vertices have no normals (nx ny nz); an oriented point set "
-                                 "is needed: export with normals")
-        if any(p[1] is None for p in props):
-            raise PointFileError(f"{path}: list properties on PLY vertices are not supported")
-        if fmt == "ascii":
-            data = np.loadtxt(f, max_rows=count, ndmin=2)
-            cols = {n: data[:, i] for i, n in enumerate(names)}
-        elif fmt in ("binary_little_endian", "binary_big_endian"):
-            end = "<" if fmt == "binary_little_endian" else ">"
-            dtype = np.dtype([(n, end + t) for n, t, _ in props])
-            data = np.frombuffer(f.read(dtype.itemsize * count), dtype=dtype, count=count)
-            cols = {n: data[n].astype(np.float64) for n in names}
-        else:
-            raise PointFileError(f"{path}: unknown PLY format '{fmt}'")
-    pos = np.stack([cols["x"], cols["y"], cols["z"]], axis=1)
-    nrm = np.stack([cols["nx"], cols["ny"], cols["nz"]], axis=1)
+        rows = [(n, line.split()) for n, line in enumerate(f, 1) if line.strip() and not line.lstrip().startswith(b"#")]
+    if not rows:
+        return np.zeros((0, 3)), np.zeros((0, 3))
+    n, words = min(rows, key=lambda r: len(r[1]))
+    if len(words) < 6:
+        raise PointFileError(f"{path} line {n}: {len(words)} numbers; an oriented point set needs six a line "
+                             f"(x y z nx ny nz){': the file has no normals' if len(words) == 3 else ''}; " + GIVE)
+    try:
+        data = np.array([w[:6] for _, w in rows], np.float64)
+    except ValueError:
+        n, word = next((n, x) for n, w in rows for x in w[:6] if not ply._is_number(x))
+        raise PointFileError(f"{path} line {n}: '{word.decode('ascii', 'replace')}' is not a number; fix or "
+                             "re-export the file") from None
+    return data[:, :3], data[:, 3:6]
+
+
+def _read_ply(path):
+    try:
+        data = ply.read(path)
+    except ply.PlyError as exc:
+        raise PointFileError(f"{path}: {exc}") from None
+    vertex = data.data.get("vertex", {})
+    faces = data.element("face").count if data.element("face") else 0
+    for names, what in (("xyz", "no positions (x y z)"), (("nx", "ny", "nz"), "no normals (nx ny nz)")):
+        if not all(c in vertex for c in names):
+            mesh = f"a mesh ({faces} faces) whose vertices have " if faces else "its vertices have "
+            raise PointFileError(f"{path}: {mesh}{what}, it is not an oriented point set; " + GIVE)
+        if any(isinstance(vertex[c], ply.List) for c in names):
+            raise PointFileError(f"{path}: the vertices' {' '.join(names)} are lists, not numbers; " + GIVE)
+    pos = np.stack([np.asarray(vertex[c], np.float64) for c in "xyz"], axis=1)
+    nrm = np.stack([np.asarray(vertex[c], np.float64) for c in ("nx", "ny", "nz")], axis=1)
     return pos, nrm
 
 
