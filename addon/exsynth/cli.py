@@ -989,7 +989,7 @@ def _points_parser(sub):
 def _points_exemplar(args, points_ops):
     from .io import point_files
 
-    point_file = bool(args.exemplar) and os.path.splitext(args.exemplar)[1].lower() in (".ply", ".xyz", ".pwn")
+    point_file = bool(args.exemplar) and point_files.is_point_file(args.exemplar)
     _require(not point_file or args.density is None,
              "--density goes with --preset or a height-field image; a point file's points are used as they are")
     for flag, value in (("--pixel-size", args.pixel_size), ("--height-scale", args.height_scale)):

@@ -108,3 +108,17 @@ def test_a_malformed_points_exemplar_is_refused(tmp_path, capsys, header, body, 
                                      str(tmp_path / "x.ply")],
                   f"--exemplar: {path}: ", message)
     assert "fix or re-export the file" in err or "give an oriented point set" in err, err
+
+
+@pytest.mark.parametrize("name, body, message", [
+    ("cow.obj", None, "a mesh (.obj) has no per-point normals, it is not an oriented point set; give an oriented"),
+    ("part.stl", b"solid x\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0 0\nvertex 0 1 0\n"
+                 b"endloop\nendfacet\nendsolid x\n", "a mesh (.stl) has no per-point normals"),
+    ("empty.xyz", b"", "the file holds no points; give an oriented point set"),
+])
+def test_a_mesh_or_an_empty_file_as_points_exemplar_is_refused(tmp_path, capsys, name, body, message):
+    """A mesh was called an unreadable image; an empty .xyz was said to have no normals."""
+    path = tmp_path / name
+    path.write_bytes(open(BUNNY_OBJ, "rb").read() if body is None else body)
+    refused(capsys, tmp_path, ["points", "--exemplar", str(path), "--size", "2", "2", "--out",
+                               str(tmp_path / "x.ply")], f"--exemplar: {path}: ", message)
