@@ -1,10 +1,8 @@
 # SPDX-License-Identifier: GPL-3.0-or-later
 """Helpers shared by the add-on tests (plain functions; fixtures are in conftest.py)."""
 
-import contextlib
-import fcntl
 import os
-import struct
+import sys
 import threading
 import time
 
@@ -17,22 +15,8 @@ ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)
 BUNNY_OBJ = os.path.join(ROOT, "assets", "meshes", "bunny.obj")
 COW_OBJ = os.path.join(ROOT, "assets", "meshes", "cow.obj")
 TEXTURES = os.path.join(ROOT, "assets", "textures")
-FS_IOC_GETFLAGS, FS_IOC_SETFLAGS = 0x80086601, 0x40086602  # linux/fs.h
-
-
-@contextlib.contextmanager
-def immutable(path):
-    """The file marked immutable for the block (what `chattr +i` does; no chattr binary needed)."""
-    fd = os.open(path, os.O_RDONLY)
-    try:
-        flags = struct.unpack("l", fcntl.ioctl(fd, FS_IOC_GETFLAGS, struct.pack("l", 0)))[0]
-        fcntl.ioctl(fd, FS_IOC_SETFLAGS, struct.pack("l", flags | 0x10))
-        try:
-            yield path
-        finally:
-            fcntl.ioctl(fd, FS_IOC_SETFLAGS, struct.pack("l", flags))
-    finally:
-        os.close(fd)
+sys.path.append(os.path.join(ROOT, "tests", "python"))  # fsmarks, shared with the Python-module tier
+from fsmarks import immutable  # noqa: E402,F401  (re-exported for the tests)
 
 
 def scene_state():

@@ -1,30 +1,10 @@
 """Shared fixtures for the Python-module tier (plain /usr/bin/python3, no bpy)."""
-import contextlib
-import fcntl
-import os
-import struct
 from pathlib import Path
 
 import numpy as np
 import pytest
 
 ASSETS = Path(__file__).resolve().parents[2] / "assets"
-FS_IOC_GETFLAGS, FS_IOC_SETFLAGS = 0x80086601, 0x40086602  # linux/fs.h
-
-
-@contextlib.contextmanager
-def immutable(path):
-    """The file marked immutable for the block (what `chattr +i` does; no chattr binary needed)."""
-    fd = os.open(path, os.O_RDONLY)
-    try:
-        flags = struct.unpack("l", fcntl.ioctl(fd, FS_IOC_GETFLAGS, struct.pack("l", 0)))[0]
-        fcntl.ioctl(fd, FS_IOC_SETFLAGS, struct.pack("l", flags | 0x10))
-        try:
-            yield path
-        finally:
-            fcntl.ioctl(fd, FS_IOC_SETFLAGS, struct.pack("l", flags))
-    finally:
-        os.close(fd)
 
 
 def pytest_configure(config):

@@ -3,7 +3,7 @@
 import os
 
 import pytest
-from conftest import immutable
+from fsmarks import immutable
 
 from exsynth.io.outputs import OutputFiles, OutputPathError
 
