@@ -73,7 +73,7 @@ def main(argv=None) -> int:
     if isinstance(done, str):
         print(done)
         return 0
-    return done
+    return done or 0  # the demo: its stages return a failure's exit code, or None
 
 
 def _with_flags(parser, job, message):
@@ -174,7 +174,6 @@ def _parser():
     p.add_argument("--padding", type=_int, default=2, help="empty voxels on every side (default 2)")
     p.add_argument("--supersample", type=_int, default=2, help="sub-rays per voxel edge, 1..8 (default 2)")
     p.add_argument("--mesh-out", help="also write the rebuilt surface (zero level of the sdf) as .obj")
-    p.add_argument("--seed", type=_seed, default=0, help="random seed (default 0)")
     p.add_argument("--memory-budget", type=_gib, default=0.0,
                    help="refuse jobs needing more than this many GiB (default: the engine's 8 GiB)")
     p.set_defaults(run=_run_voxelize)
@@ -230,10 +229,10 @@ def _parser():
     p.add_argument("--mesh", help="also bake the solid onto this mesh (.obj, .ply, .stl; unwrapped with "
                    "Smart UV Project when it has no UVs)")
     p.add_argument("--bake-out", help="the baked texture (.png), with --mesh")
-    p.add_argument("--bake-size", type=_int, default=512, help="baked texture width and height (default 512)")
-    p.add_argument("--bake-interpolation", choices=_native.INTERPOLATION_CHOICES, default=_native.DEFAULT_INTERPOLATION,
+    p.add_argument("--bake-size", type=_int, help="with --mesh: baked texture width and height (default 512)")
+    p.add_argument("--bake-interpolation", choices=_native.INTERPOLATION_CHOICES,
                    help="with --mesh: how texels read the solid between voxels; cubic keeps voxel-sized detail's "
-                   "contrast, linear is softer (default %(default)s)")
+                   f"contrast, linear is softer (default {_native.DEFAULT_INTERPOLATION})")
     p.add_argument("--mesh-out", help="with --mesh: write the mesh with the UV map the bake used (.obj)")
     p.add_argument("--memory-budget", type=_gib, default=0.0,
                    help="refuse jobs needing more than this many GiB (default: the engine's 8 GiB)")
@@ -251,10 +250,11 @@ def _parser():
     p.add_argument("--tileable", action="store_true", help="make the output tile (opposite edges continue)")
     p.add_argument("--method", choices=_native.IMAGE_METHODS, default=_native.IMAGE_DEFAULT_METHOD,
                    help="coordinates (fast, every pixel an exemplar pixel) or optimization (default %(default)s)")
-    p.add_argument("--levels", type=_int, default=_native.DEFAULT_LEVELS,
-                   help="optimization: coarse-to-fine levels (default %(default)s)")
-    p.add_argument("--iterations", type=_int, default=_native.DEFAULT_ITERATIONS,
-                   help="optimization: rounds per level (default %(default)s)")
+    p.add_argument("--levels", type=_int,
+                   help=f"with --method optimization: coarse-to-fine levels (default {_native.DEFAULT_LEVELS}; "
+                   "coordinates takes its levels from the exemplar)")
+    p.add_argument("--iterations", type=_int,
+                   help=f"with --method optimization: rounds per level (default {_native.DEFAULT_ITERATIONS})")
     p.add_argument("--seed", type=_seed, default=0, help="random seed (default 0)")
     p.add_argument("--alpha", action="store_true", help="synthesize the exemplar's alpha too")
     p.add_argument("--memory-budget", type=_gib, default=0.0,
@@ -309,9 +309,10 @@ def _parser():
     p.add_argument("--out", required=True,
                    help=".obj (B''s isosurface), .vdb (grids sdf and density) or .npy ((Z, Y, X) float32 "
                    "signed distance of B', positive outside)")
-    p.add_argument("--dilation", type=_finite, default=0.15, help="dilate: A' radius minus A's (default 0.15)")
-    p.add_argument("--spike-height", type=_finite, default=0.3, help="spikes: cone height (default 0.3)")
-    p.add_argument("--seed", type=_seed, default=0, help="random seed (default 0)")
+    p.add_argument("--dilation", type=_finite,
+                   help=f"with --preset dilate: A' radius minus A's (default {analogy_ops.DEFAULT_GROWTH['dilation']:g})")
+    p.add_argument("--spike-height", type=_finite,
+                   help=f"with --preset spikes: cone height (default {analogy_ops.DEFAULT_GROWTH['feature_height']:g})")
     p.add_argument("--memory-budget", type=_gib, default=0.0,
                    help="refuse jobs needing more than this many GiB (default: the engine's 8 GiB)")
     p.set_defaults(run=_run_analogy)
@@ -352,7 +353,7 @@ def _run_voxelize(args):
         name=os.path.splitext(os.path.basename(mesh_path))[0], vertices=verts, triangles=tris,
         resolution=args.resolution, voxel_size=args.voxel_size, padding=args.padding,
         supersample=args.supersample, make_mesh=bool(args.mesh_out),
-        memory_budget=int(args.memory_budget * GIB), seed=args.seed,
+        memory_budget=int(args.memory_budget * GIB),
     )
     voxels, seconds = _run_job(job, "voxelize")
     if voxels.warning():
@@ -385,6 +386,9 @@ def _run_analogy(args):
              "--field-preset along_curve needs --curve CURVE.obj (or .npy)")
     _require(not args.curve or args.field_preset == "along_curve", "--curve goes with --field-preset along_curve")
     _require(any(args.axis), "--axis must not be 0 0 0: give the axis direction, e.g. --axis 0 0 1")
+    _goes_with("--dilation", args.dilation is not None, args.preset == "dilate", "--preset dilate")
+    _goes_with("--spike-height", args.spike_height is not None, args.preset == "spikes", "--preset spikes")
+    _goes_with("--pattern-size", args.pattern_size is not None, args.preset, "a built-in pair (--preset)")
     if args.preset:
         _require(args.pattern_size is None or args.pattern_size > 0,
                  f"--pattern-size must be > 0 (got {args.pattern_size})")
@@ -417,7 +421,7 @@ def _run_analogy(args):
         b=b, preset=args.preset or "spikes", resolution=args.resolution,
         pattern_scale=0.5 if pattern_scale is None else pattern_scale,
         pair_options=_pair_options(args),
-        memory_budget=int(args.memory_budget * GIB), seed=args.seed,
+        memory_budget=int(args.memory_budget * GIB),
     )
     if not args.preset:
         job.a = _analogy_mesh("--a", a_path, field)
@@ -450,8 +454,8 @@ def _run_analogy(args):
 
 def _pair_options(args):
     """The built-in pair's shape options the CLI sets (as operators.analogy.pair_options)."""
-    return {"dilate": {"dilation": args.dilation},
-            "spikes": {"feature_height": args.spike_height}}.get(args.preset, {})
+    given = {"dilation": args.dilation, "feature_height": args.spike_height}
+    return {k: v for k, v in given.items() if v is not None}
 
 
 def _analogy_mesh(arg, path, field):
@@ -559,7 +563,11 @@ def _run_solid(args):
     _require(args.scale >= 0, f"--scale must be >= 0 (got {args.scale}); 0 picks it from the mesh")
     _require(args.memory_budget >= 0, f"--memory-budget must be >= 0 GiB (got {args.memory_budget})")
     _require(bool(args.mesh) == bool(args.bake_out), "--mesh and --bake-out go together")
-    _require(not args.mesh_out or args.mesh, "--mesh-out needs --mesh")
+    for flag, value in (("--mesh-out", args.mesh_out), ("--bake-size", args.bake_size),
+                        ("--bake-interpolation", args.bake_interpolation)):
+        _goes_with(flag, value is not None, args.mesh, "--mesh")
+    args.bake_size = 512 if args.bake_size is None else args.bake_size
+    args.bake_interpolation = args.bake_interpolation or _native.DEFAULT_INTERPOLATION
     if args.mesh:
         mesh_path = _input_file("--mesh", args.mesh, MESH_FORMATS)
         bake_out = args.outputs.add("--bake-out", args.bake_out, (".png",))
@@ -610,6 +618,10 @@ def _run_image(args):
     out = args.outputs.add("--out", args.out, (".png",))
     _require(args.width > 0 and args.height > 0,
              f"--width and --height must be > 0 (got {args.width}x{args.height})")
+    for flag, value in (("--levels", args.levels), ("--iterations", args.iterations)):
+        _goes_with(flag, value is not None, args.method == "optimization", "--method optimization")
+    args.levels = _native.DEFAULT_LEVELS if args.levels is None else args.levels
+    args.iterations = _native.DEFAULT_ITERATIONS if args.iterations is None else args.iterations
     _require(args.levels > 0, f"--levels must be > 0 (got {args.levels})")
     if args.method == "optimization":
         _texture_size("--width and --height", (args.width, args.height), args.levels, _native.IMAGE_MAX_SIZE,
@@ -818,6 +830,11 @@ def _gib(text):
     return value
 
 
+def _goes_with(flag, given, ok, partner):
+    """Refuse `flag` where it would do nothing: it goes with `partner`."""
+    _require(not given or ok, f"{flag} goes with {partner}; here it would have no effect")
+
+
 def _require(ok, message):
     if not ok:
         raise UsageError(message)
@@ -866,12 +883,12 @@ def _add_surface_parser(sub):
     field.add_argument("--field-preset", choices=tuple(surface_ops.FIELD_MODES.values()), default="smooth",
                        help="which way the pattern runs (default smooth: a smooth field from --axis)")
     field.add_argument("--field", help="(V, 3) .npy, a direction per vertex of --mesh (e.g. 'run field')")
-    p.add_argument("--axis", type=_finite, nargs=3, metavar=("X", "Y", "Z"), default=(0.0, 0.0, 1.0),
+    p.add_argument("--axis", type=_finite, nargs=3, metavar=("X", "Y", "Z"),
                    help="the presets' axis in the file's coordinates (default 0 0 1)")
     p.add_argument("--segments", type=_int, default=2,
                    help="limit-mesh quads along each n-gon sub-face, twice that per quad (default 2)")
-    p.add_argument("--height-scale", type=_finite, default=0.02,
-                   help="displacement per unit of height around 0.5 (default 0.02)")
+    p.add_argument("--height-scale", type=_finite,
+                   help="with --height: displacement per unit of height around 0.5 (default 0.02)")
     p.add_argument("--out", required=True, help="the textured limit mesh: .obj (+ .mtl)")
     p.add_argument("--texture-out", required=True, help="the atlas: .png")
     p.add_argument("--height-out", help="with --height: the height atlas, .png")
@@ -887,7 +904,11 @@ def _run_surface(args):
     mesh_path = _input_file("--mesh", args.mesh, MESH_FORMATS)
     exemplar_path = _input_file("--exemplar", args.exemplar, None)
     height_path = _input_file("--height", args.height, None) if args.height else None
-    _require(not args.height_out or args.height, "--height-out needs --height")
+    for flag, value in (("--height-out", args.height_out), ("--height-scale", args.height_scale)):
+        _goes_with(flag, value is not None, args.height, "--height")
+    _goes_with("--axis", args.axis is not None, not args.field, "--field-preset (--field sets every direction)")
+    args.axis = (0.0, 0.0, 1.0) if args.axis is None else args.axis
+    args.height_scale = 0.02 if args.height_scale is None else args.height_scale
     out = args.outputs.add("--out", args.out, (".obj",))
     mtl_final = os.path.splitext(args.out)[0] + ".mtl"
     mtl = args.outputs.add("--out (its .mtl)", mtl_final, (".mtl",))

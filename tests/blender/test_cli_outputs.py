@@ -88,9 +88,6 @@ def test_successful_outputs_replace_old_files(tmp_path, capsys):
 
 
 @pytest.mark.parametrize("option, message", [
-    (["--seed", "-1"], "argument --seed: -1 is out of range; give 0 .. 2**64-1"),
-    (["--seed", str(2**64)], "is out of range; give 0 .. 2**64-1"),
-    (["--seed", "1.5"], "argument --seed: '1.5' is not a whole number"),
     (["--memory-budget", "inf"], "argument --memory-budget: inf GiB is out of range"),
     (["--memory-budget", "1e30"], "argument --memory-budget: 1e30 GiB is out of range"),
     (["--memory-budget", "-1"], "argument --memory-budget: -1 GiB is out of range"),
@@ -105,10 +102,34 @@ def test_numbers_out_of_range_are_refused_by_name(tmp_path, capsys, option, mess
     assert os.listdir(tmp_path) == []
 
 
+def image_job(tmp_path, *extra):
+    return ["image", "--exemplar", CRACKED, "--width", "16", "--height", "16",
+            "--out", str(tmp_path / "x.png"), *extra]
+
+
+@pytest.mark.parametrize("seed, message", [
+    ("-1", "argument --seed: -1 is out of range; give 0 .. 2**64-1"),
+    (str(2**64), "is out of range; give 0 .. 2**64-1"),
+    ("1.5", "argument --seed: '1.5' is not a whole number"),
+])
+def test_a_seed_out_of_range_is_refused_by_name(tmp_path, capsys, seed, message):
+    code, err = run(capsys, *image_job(tmp_path, "--seed", seed))
+    assert code == 2 and message in err and "Traceback" not in err
+    assert os.listdir(tmp_path) == []
+
+
 def test_seed_up_to_2_64_minus_1_works(tmp_path, capsys):
-    code, _ = run(capsys, "voxelize", "--mesh", BUNNY_OBJ, "--resolution", "12", "--seed", str(2**64 - 1),
-                  "--out", str(tmp_path / "x.npy"))
-    assert code == 0
+    code, _ = run(capsys, *image_job(tmp_path, "--seed", str(2**64 - 1)))
+    assert code == 0 and os.listdir(tmp_path) == ["x.png"]
+
+
+@pytest.mark.parametrize("job", [["voxelize", "--mesh", BUNNY_OBJ],
+                                 ["analogy", "--b", BUNNY_OBJ, "--preset", "spikes"]])
+def test_no_seed_where_nothing_is_random(tmp_path, capsys, job):
+    """The voxelizer and the analogy are deterministic: --seed did nothing there, so it is gone."""
+    code, err = run(capsys, *job, "--out", str(tmp_path / "x.npy"), "--seed", "3")
+    assert code == 2 and "unrecognized arguments: --seed 3" in err
+    assert os.listdir(tmp_path) == []
 
 
 def test_ctrl_c_cancels_the_job_and_writes_nothing(tmp_path):

@@ -224,7 +224,7 @@ def test_cli_writes_mesh_mtl_and_atlas(tmp_path, capsys):
 
 @pytest.mark.parametrize("extra, code, message", [
     (["--face-resolution", "0"], 2, "--face-resolution must be > 0"),
-    (["--height-out", "h.png"], 2, "--height-out needs --height"),
+    (["--height-out", "h.png"], 2, "--height-out goes with --height"),
     (["--field", "nofield.npy"], 2, "nofield.npy"),
     (["--method", "multiscale", "--face-resolution", "600"], 2, "--face-resolution must be in 1..512"),
 ])

@@ -39,7 +39,7 @@ MAX_GRID_SIDE = 2048  # voxels along one side of a user pair's grid
 # How far A' reaches beyond A in the pair's own units (the pair spans
 # [-1, 1]^3): the grid around B needs that much room to grow into.
 _PAIR_GROWTH = {"spikes": "feature_height", "dilate": "dilation"}
-_DEFAULT_GROWTH = {"feature_height": 0.3, "dilation": 0.15}
+DEFAULT_GROWTH = {"feature_height": 0.3, "dilation": 0.15}
 
 
 def pair_resolution(resolution, pattern_scale):
@@ -168,7 +168,6 @@ class GeometricTextureJob(Job):
     pattern_scale: float = 0.5  # built-in pairs only
     pair_options: dict = dataclasses.field(default_factory=dict)
     memory_budget: int = 0  # bytes; 0 = the engine's default
-    seed: int = 0
 
     label = "geometric texture"
 
@@ -188,12 +187,12 @@ class GeometricTextureJob(Job):
         """Empty voxels around B for a built-in pair: room for A' to grow
         into, plus the neighbourhoods."""
         key = _PAIR_GROWTH.get(self.preset)
-        growth = self.pair_options.get(key, _DEFAULT_GROWTH.get(key, 0.0)) if key else 0.0
+        growth = self.pair_options.get(key, DEFAULT_GROWTH.get(key, 0.0)) if key else 0.0
         return int(math.ceil(growth * self.pair_resolution / 2.0)) + _native.analogy_padding()
 
     def run(self, ctx):
         h = voxel_size_for(self.b.vertices, self.resolution)
-        common = dict(supersample=2, compute_sdf=True, memory_budget=self.memory_budget, seed=self.seed, ctx=ctx)
+        common = dict(supersample=2, compute_sdf=True, memory_budget=self.memory_budget, ctx=ctx)
         if self.user_pair:
             a, a_prime, field_a, growth, region = self._user_pair(h, common, ctx)
             padding = int(math.ceil(growth / h)) + _native.analogy_padding()
@@ -208,7 +207,7 @@ class GeometricTextureJob(Job):
         if not self.user_pair:
             self.share(ctx, 0.27, 0.3)
             pair = _native.make_exemplar_pair(
-                self.preset, resolution=self.pair_resolution, seed=self.seed, ctx=ctx,
+                self.preset, resolution=self.pair_resolution, ctx=ctx,
                 memory_budget=self.memory_budget, **self.pair_options,
             )
             a, a_prime, field_a = pair["a"], pair["a_prime"], pair["field"]
@@ -225,7 +224,7 @@ class GeometricTextureJob(Job):
         self.share(ctx, 0.3, 0.97)
         res = _native.synthesize_analogy(
             a, a_prime, np.ascontiguousarray(b / scale, np.float32), field_a=field_a, field_b=field_b,
-            voxel_size=h_a, a_region=region, memory_budget=self.memory_budget, seed=self.seed, ctx=ctx,
+            voxel_size=h_a, a_region=region, memory_budget=self.memory_budget, ctx=ctx,
         )
         b_prime = np.ascontiguousarray(res["b_prime"] * scale, np.float32)
         self.share(ctx, 0.97, 1.0)
@@ -529,7 +528,7 @@ class EXSYNTH_OT_geometric_texture(JobOperator, bpy.types.Operator):
         job = GeometricTextureJob(
             b=b, preset=settings.geo_preset.lower(), resolution=settings.geo_resolution,
             pattern_scale=scale, pair_options=pair_options(settings),
-            memory_budget=settings.memory_budget_bytes, seed=settings.seed,
+            memory_budget=settings.memory_budget_bytes,
         )
         if settings.geo_pair_source == 'OBJECTS':
             job.a, job.a_prime = user_pair(context, settings, b)

@@ -50,7 +50,6 @@ class VoxelizeJob(Job):
     supersample: int = 2
     make_mesh: bool = True
     memory_budget: int = 0  # bytes; 0 = the engine's default
-    seed: int = 0
 
     label = "voxelize"
 
@@ -60,7 +59,7 @@ class VoxelizeJob(Job):
             self.vertices, self.triangles,
             resolution=self.resolution, voxel_size=self.voxel_size, padding=self.padding,
             supersample=self.supersample, compute_sdf=True,
-            memory_budget=self.memory_budget, seed=self.seed, ctx=ctx,
+            memory_budget=self.memory_budget, ctx=ctx,
         )
         voxels = Voxels(self.name, grids["density"], grids["sdf"], grids["origin"], grids["voxel_size"])
         if self.make_mesh:
@@ -116,7 +115,7 @@ class EXSYNTH_OT_voxelize(JobOperator, bpy.types.Operator):
             name=obj.name, vertices=verts, triangles=tris,
             resolution=settings.resolution, padding=settings.padding,
             supersample=settings.supersample, make_mesh=settings.make_mesh,
-            memory_budget=settings.memory_budget_bytes, seed=settings.seed,
+            memory_budget=settings.memory_budget_bytes,
         )
 
     def finish(self, context, voxels, created):

@@ -96,7 +96,7 @@ class EXSYNTH_PT_geometric_texture_advanced(SidebarPanel, bpy.types.Panel):
     bl_options = {'DEFAULT_CLOSED'}
 
     def draw(self, context):
-        draw_shared_advanced(self._layout(), context.scene.exsynth)
+        draw_shared_advanced(self._layout(), context.scene.exsynth, seed=False)
 
 
 CLASSES = (EXSYNTH_PT_geometric_texture, EXSYNTH_PT_geometric_texture_advanced)

@@ -32,9 +32,11 @@ def draw_field_preset(col, settings, prefix):
         col.row().prop(settings, f"{prefix}axis", expand=True)
 
 
-def draw_shared_advanced(layout, settings):
-    """Seed and memory budget: scene-wide settings every tool's Advanced panel shows."""
-    layout.prop(settings, "seed")
+def draw_shared_advanced(layout, settings, seed=True):
+    """Seed and memory budget: scene-wide settings the tools' Advanced panels
+    show (the seed only where something is random)."""
+    if seed:
+        layout.prop(settings, "seed")
     layout.prop(settings, "memory_budget_gib", text="Memory Budget (GiB)")
     layout.label(text="Shared with Voxelize", icon='LINKED')
 
@@ -82,7 +84,6 @@ class EXSYNTH_PT_voxelize_advanced(bpy.types.Panel):
         layout.use_property_split = True
         layout.use_property_decorate = False
         settings = context.scene.exsynth
-        layout.prop(settings, "seed")
         layout.prop(settings, "memory_budget_gib", text="Memory Budget (GiB)")
 
 
