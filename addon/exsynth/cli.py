@@ -1048,7 +1048,7 @@ def _points_exemplar(args, points_ops):
     lo, hi = np.array(ex["box_min"]), np.array(ex["box_max"])
     exemplar = points_ops.Exemplar(name=name, positions=ex["positions"] - np.r_[lo, 0.0], normals=ex["normals"])
     exemplar.box = ((0.0, 0.0), tuple(hi - lo))
-    return exemplar, "default"
+    return exemplar, "heightfield"
 
 
 def _points_options(args, exemplar, preset):
@@ -1128,7 +1128,7 @@ def _run_points(args):
     result, seconds = _run_job(job, "points")
     point_files.write_points(out, result.positions, result.normals)
     t = result.stats["times"]
-    line = (f"points: {exemplar.name} -> {len(result.positions)} points, {result.stats['patches']} patches, "
+    line = (f"points: {exemplar.name} ({preset} weights) -> {len(result.positions)} points, {result.stats['patches']} patches, "
             f"{result.stats['pairs']} pairs (search {t['search']:.2f} s, warp {t['warp']:.2f} s, blend "
             f"{t['blend']:.2f} s, other {t['other']:.2f} s) in {seconds:.2f} s -> {args.out}")
     if mesh_out:

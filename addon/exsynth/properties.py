@@ -15,6 +15,8 @@ GIB = 1 << 30
 # what one level allows and the soft min what the default 3 levels need; the
 # operator checks the pair (operators/solid.py check_size).
 SOLID_DEFAULT_LEVELS = _native.DEFAULT_LEVELS
+# Point Texture's Custom Weights start from the engine's options for user exemplars.
+_POINT_DEFAULTS = _native.point_texture_preset("default")
 
 # The engine's solid methods (_native.SOLID_METHODS); the enum's identifiers
 # are the names upper-cased, the job passes them back lower-cased.
@@ -484,19 +486,21 @@ class ExSynthSettings(bpy.types.PropertyGroup):
                                 "(OpenVDB particles to level set to mesh)", default=False)
     pts_custom_weights: BoolProperty(name="Custom Weights", description="Use the weights below instead of "
                                      "the texture's preset", default=False)
-    pts_extra: FloatProperty(name="Overlap", description="The overlap E as a fraction of the patch", default=0.3,
-                             min=0.1, max=0.5)
+    pts_extra: FloatProperty(name="Overlap", description="The overlap E as a fraction of the patch",
+                             default=_POINT_DEFAULTS["extra"], min=0.1, max=0.5)
     pts_epsilon: FloatProperty(name="Epsilon", description="Candidates within (1 + epsilon) of the best "
-                               "are picked at random", default=0.1, min=0.0, soft_max=1.0)
-    pts_w_p: FloatProperty(name="Position", description="Pairing: weight of the position difference",
-                           default=1.0, min=0.0)
-    pts_w_n: FloatProperty(name="Normal", description="Pairing: weight of the normal difference", default=1.0, min=0.0)
-    pts_w_v: FloatProperty(name="Variation", description="Pairing: weight of the surface-variation difference",
-                           default=1.0, min=0.0)
-    pts_w_l: FloatProperty(name="Length", description="Coherence: weight of displacement length differences",
-                           default=1.0, min=0.0)
-    pts_w_d: FloatProperty(name="Direction", description="Coherence: weight of displacement direction "
-                           "differences", default=1.0, min=0.0)
+                               "are picked at random", default=_POINT_DEFAULTS["epsilon"], min=0.0, soft_max=1.0)
+    pts_w_p: FloatProperty(name="Position", description="Pairing: weight of the squared position difference "
+                           "(in point spacings)", default=_POINT_DEFAULTS["w_p"], min=0.0)
+    pts_w_n: FloatProperty(name="Normal", description="Pairing: weight of the normal difference, (1 - cos) / 2",
+                           default=_POINT_DEFAULTS["w_n"], min=0.0)
+    pts_w_v: FloatProperty(name="Variation", description="Pairing: weight of the squared surface-variation "
+                           "difference", default=_POINT_DEFAULTS["w_v"], min=0.0)
+    pts_w_l: FloatProperty(name="Length", description="Coherence: weight of the displacement's length "
+                           "difference from its neighbours' (in point spacings)",
+                           default=_POINT_DEFAULTS["w_l"], min=0.0)
+    pts_w_d: FloatProperty(name="Direction", description="Coherence: weight of the displacement's direction "
+                           "difference from its neighbours', (1 - cos) / 2", default=_POINT_DEFAULTS["w_d"], min=0.0)
     # ---- Surface Texture (texture synthesis on the subdivision surface) ----
     surface_exemplar: PointerProperty(
         name="Exemplar", description="The image whose pattern covers the surface", type=bpy.types.Image,

@@ -61,7 +61,7 @@ PointExemplar to_exemplar(const py::handle& positions, const py::handle& normals
   return ex;
 }
 
-constexpr const char* kPresetNames = "default, bumps, chainmail, weave or flowers";
+constexpr const char* kPresetNames = kPointPresetNames;
 // Bounds the core leaves open (it checks padding against the image and smoothing >= 0).
 constexpr int kMaxHeightFieldPadding = 1 << 20;
 constexpr int kMaxPointMeshSmoothing = 64;
@@ -155,7 +155,8 @@ void bind_points(py::module_& m) {
         return options_dict(point_texture_preset(string_arg(name, "name", kPresetNames)));
       },
       py::arg("name") = "default",
-      "The synthesis options (a dict) tuned for a built-in texture: default, bumps, chainmail, weave, flowers.");
+      "The synthesis options (a dict) for a built-in texture: default, heightfield (= bumps), chainmail, weave, "
+      "flowers; the pairing weights are the paper's Table 1 rows.");
 
   m.def(
       "make_point_exemplar",

@@ -146,13 +146,13 @@ def test_cli_preset_plane_ply_and_mesh(tmp_path, capsys):
     rc = cli.main(["points", "--preset", "chainmail", "--size", "1", "1", "--density", "2500",
                    "--out", str(out), "--mesh-out", str(surf), "--seed", "3"])
     assert rc == 0
-    assert "points: chainmail ->" in capsys.readouterr().out
+    assert "points: chainmail (chainmail weights) ->" in capsys.readouterr().out
     pos, nrm = point_files.read_points(str(out))
     assert len(pos) > 1000 and pos[:, :2].min() >= -1e-3 and pos[:, :2].max() <= 1 + 1e-3
     assert surf.stat().st_size > 1000
 
 
-def test_cli_height_field_png_and_target(tmp_path):
+def test_cli_height_field_png_and_target(tmp_path, capsys):
     img = bpy.data.images.new("hf", 48, 48)
     y, x = np.mgrid[0:48, 0:48]
     grey = (0.5 + 0.5 * np.sin(x / 3.0) * np.cos(y / 4.0)).astype(np.float32)
@@ -166,6 +166,7 @@ def test_cli_height_field_png_and_target(tmp_path):
                      "30000", "--out", str(out)]) == 0
     text = out.read_text()
     assert text.count("\nv ") > 1000 and text.count("\nvn ") == text.count("\nv ")
+    assert "(heightfield weights)" in capsys.readouterr().out  # Table 1's height-field row
     out2 = tmp_path / "bunny.ply"
     assert cli.main(["points", "--preset", "bumps", "--target", BUNNY_OBJ, "--density", "150", "--scale", "1.5",
                      "--patch-size", "0.6", "--axis", "0", "1", "0", "--out", str(out2)]) == 0
@@ -227,3 +228,24 @@ def test_cli_field_arguments_that_do_not_fit(tmp_path, capsys):
         assert cli.main(base + extra) == 2, extra
         assert message in capsys.readouterr().err, (extra, message)
     assert not (tmp_path / "x.ply").exists()
+
+
+def test_the_panels_weights_are_the_presets_and_custom_weights_start_from_the_default():
+    from exsynth import _native
+    from exsynth.operators.points import options_from
+
+    s = bpy.context.scene.exsynth
+    keys = ("w_p", "w_n", "w_v", "w_l", "w_d")
+    default = _native.point_texture_preset("default")
+    assert {k: s.bl_rna.properties[f"pts_{k}"].default for k in keys} == {k: default[k] for k in keys}
+    s.pts_custom_weights = False
+    for built_in, preset in (("bumps", "heightfield"), ("chainmail", "chainmail"), ("weave", "weave"),
+                             ("flowers", "flowers")):
+        opts, ref = options_from(s, built_in), _native.point_texture_preset(preset)
+        assert {k: opts[k] for k in keys} == {k: ref[k] for k in keys}, built_in
+    try:
+        s.pts_custom_weights, s.pts_w_v = True, 7.0
+        assert options_from(s, "bumps")["w_v"] == 7.0
+    finally:
+        s.pts_custom_weights = False
+        s.property_unset("pts_w_v")

@@ -215,6 +215,108 @@ TEST(Pairing, CoherenceAvoidsCrossings) {
   EXPECT_GE(coherent.size(), 12u);
 }
 
+// Brute-force twin of greedy_pairs with every target a candidate: the
+// paper's cost c (Equation 2, positions in spacings) in round 0, c + g (its
+// coherence, from the previous round's pairs) after, cheapest first.
+std::vector<points::PointPair> greedy_pairs_by_hand(const std::vector<points::PairPoint>& src,
+                                                    const std::vector<points::PairPoint>& dst,
+                                                    const points::PairingOptions& o) {
+  struct Cand { std::uint32_t s, t; double c, total; };
+  std::vector<Cand> cands;
+  for (std::uint32_t i = 0; i < src.size(); ++i)
+    for (std::uint32_t j = 0; j < dst.size(); ++j) {
+      const double d2 = double((dst[j].p - src[i].p).squaredNorm()), dot = double(src[i].n.dot(dst[j].n));
+      const double dv = double(src[i].sigma) - double(dst[j].sigma);
+      if (d2 > o.max_distance * o.max_distance * o.spacing * o.spacing || dot < o.min_normal_dot ||
+          std::abs(dv) > o.max_variation)
+        continue;
+      const double c = o.w_p * d2 / (o.spacing * o.spacing) + o.w_n / 2 * (1 - dot) + o.w_v * dv * dv;
+      cands.push_back({i, j, c, c});
+    }
+  auto accept = [&] {
+    std::sort(cands.begin(), cands.end(), [](const Cand& a, const Cand& b) {
+      return float(a.total) != float(b.total) ? float(a.total) < float(b.total) : a.s != b.s ? a.s < b.s : a.t < b.t;
+    });
+    std::vector<char> us(src.size(), 0), ut(dst.size(), 0);
+    std::vector<points::PointPair> out;
+    for (const Cand& c : cands)
+      if (!us[c.s] && !ut[c.t]) us[c.s] = ut[c.t] = 1, out.push_back({c.s, c.t, float(c.total)});
+    return out;
+  };
+  std::vector<points::PointPair> pairs = accept();
+  const double r = o.coherence_radius * o.spacing;
+  for (int round = 1; round < o.iterations; ++round) {
+    for (Cand& c : cands) {
+      double wsum = 0, lsum = 0;
+      Eigen::Vector3d dsum = Eigen::Vector3d::Zero();
+      for (const auto& p : pairs) {
+        const double dist2 = double((src[p.source].p - src[c.s].p).squaredNorm());
+        if (p.source == c.s || dist2 > 4 * r * r) continue;
+        const Eigen::Vector3d disp = (dst[p.target].p - src[p.source].p).cast<double>();
+        const double w = std::exp(-dist2 / (r * r));
+        wsum += w, lsum += w * disp.norm(), dsum += w * disp;
+      }
+      const Eigen::Vector3d d = (dst[c.t].p - src[c.s].p).cast<double>();
+      const double dir = 1 - dsum.normalized().dot(d.normalized());
+      c.total = c.c + (wsum > 0 ? o.w_l * std::abs(d.norm() - lsum / wsum) / o.spacing + o.w_d / 2 * dir : 0.0);
+    }
+    pairs = accept();
+  }
+  return pairs;
+}
+
+TEST(Pairing, MatchesTheBruteForcePaperCostAndCoherence) {
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<float> u(-1.0f, 1.0f);
+  std::vector<points::PairPoint> src, dst;
+  for (int i = 0; i < 24; ++i) {
+    const V3 p(float(i % 6), float(i / 6), 0.0f);
+    src.push_back({p + 0.2f * V3(u(rng), u(rng), u(rng)), V3(0.3f * u(rng), 0.3f * u(rng), 1).normalized(),
+                   0.05f + 0.04f * u(rng)});
+    dst.push_back({p + V3(0.4f, 0.1f, 0) + 0.3f * V3(u(rng), u(rng), u(rng)),
+                   V3(0.3f * u(rng), 0.3f * u(rng), 1).normalized(), 0.05f + 0.04f * u(rng)});
+  }
+  points::PairingOptions o;
+  o.spacing = 0.8;
+  o.max_distance = 2.5;
+  o.max_variation = 0.06;
+  o.candidates = 100;  // every target within reach, as the brute force
+  o.w_n = 3, o.w_v = 30, o.w_l = 9, o.w_d = 7;  // Table 1's height field
+  std::vector<std::vector<points::PointPair>> rounds;
+  for (int iterations : {1, 2, 3}) {
+    o.iterations = iterations;
+    const auto fast = points::greedy_pairs(src, dst, o), slow = greedy_pairs_by_hand(src, dst, o);
+    rounds.push_back(slow);
+    ASSERT_GE(slow.size(), 12u) << "the thresholds must leave most points paired";
+    ASSERT_EQ(fast.size(), slow.size()) << iterations << " rounds";
+    for (std::size_t k = 0; k < fast.size(); ++k) {
+      EXPECT_EQ(fast[k].source, slow[k].source) << iterations << " rounds, pair " << k;
+      EXPECT_EQ(fast[k].target, slow[k].target) << iterations << " rounds, pair " << k;
+      EXPECT_NEAR(fast[k].cost, slow[k].cost, 1e-4f * (1 + slow[k].cost));
+    }
+  }
+  auto same = [](const std::vector<points::PointPair>& a, const std::vector<points::PointPair>& b) {
+    if (a.size() != b.size()) return false;
+    for (std::size_t k = 0; k < a.size(); ++k)
+      if (a[k].source != b[k].source || a[k].target != b[k].target) return false;
+    return true;
+  };
+  EXPECT_FALSE(same(rounds[0], rounds[1])) << "the case must make the coherence change the pairing";
+}
+
+TEST(PointTexturePresets, CarryTheRowsOfThePapersTable1) {
+  struct Row { const char* name; double w_n, w_v, w_l, w_d; };
+  for (const Row& row : {Row{"heightfield", 3, 30, 9, 7}, Row{"bumps", 3, 30, 9, 7}, Row{"chainmail", 1, 10, 8, 6},
+                         Row{"weave", 2, 15, 6, 5}, Row{"flowers", 2, 2, 6, 6}}) {
+    const PointTextureOptions o = point_texture_preset(row.name);
+    EXPECT_EQ(o.w_p, 1.0) << row.name;
+    EXPECT_EQ(o.w_n, row.w_n) << row.name;
+    EXPECT_EQ(o.w_v, row.w_v) << row.name;
+    EXPECT_EQ(o.w_l, row.w_l) << row.name;
+    EXPECT_EQ(o.w_d, row.w_d) << row.name;
+  }
+}
+
 TEST(Sampling, ExactCountEvenAndOnTheSurface) {
   const TriangleMesh sphere = exsynth::testing::icosphere(1.0f, 4);
   const points::SurfaceSamples s = points::sample_surface(sphere, 2000, 7, nullptr);

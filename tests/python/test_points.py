@@ -56,6 +56,25 @@ def test_options_round_trip_and_unknown_keys(bumps):
         _native.point_texture_preset("moss")
 
 
+TABLE1 = {"heightfield": (3, 30, 9, 7), "chainmail": (1, 10, 8, 6), "weave": (2, 15, 6, 5), "flowers": (2, 2, 6, 6)}
+
+
+@pytest.mark.parametrize("name", sorted(TABLE1))
+def test_presets_carry_table1_weights_through_the_binding(name):
+    opts = _native.point_texture_preset(name)
+    assert (opts["w_p"], opts["w_n"], opts["w_v"], opts["w_l"], opts["w_d"]) == (1, *TABLE1[name])
+
+
+def test_bumps_is_the_height_field_preset_and_the_weights_change_the_output(bumps):
+    assert _native.point_texture_preset("bumps") == _native.point_texture_preset("heightfield")
+    with pytest.raises(_native.InvalidInputError, match="choose default, heightfield, bumps"):
+        _native.point_texture_preset("height")
+    runs = [_native.synthesize_points(bumps["positions"], bumps["normals"], size=(1.0, 1.0), seed=3,
+                                      options={**_native.point_texture_preset(name), **SMALL})["positions"]
+            for name in ("default", "heightfield")]
+    assert runs[0].shape != runs[1].shape or not np.array_equal(*runs)
+
+
 def _patch_score(img, ref, k=5):
     """Mean squared distance of each k x k window of img to its nearest window of ref (brute force)."""
     def windows(a):

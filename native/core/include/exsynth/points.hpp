@@ -58,16 +58,17 @@ struct PointTextureOptions {
   int grid_resolution = 12;     ///< SDF cells along a patch side (the metric's grid)
   double w_sdf = 1.0;           ///< metric: weight of the signed-distance difference
   double w_gradient = 0.25;     ///< metric: weight of the gradient (normal) difference
-  // Pairing cost c = w_p |dp|^2 / s^2 + w_n (1 - n.n') + w_v |sigma - sigma'| (s: point spacing) ...
+  // Pairing cost, the paper's Equation 2 with positions in point spacings s:
+  // c = w_p |dp|^2 / s^2 + (w_n / 2)(1 - n.n') + w_v (sigma - sigma')^2 ...
   double w_p = 1.0;
-  double w_n = 1.0;
-  double w_v = 1.0;
+  double w_n = 2.0;
+  double w_v = 20.0;
   double max_pair_distance = 3.0;   ///< ... pairs farther than this many spacings are refused
   double min_pair_normal_dot = 0.5; ///< ... and pairs whose normals disagree more
   double max_pair_variation = 0.1;  ///< ... or whose surface variations differ more
-  // Coherence g with the neighbouring pairs (Gaussian weights over a patch cell):
-  double w_l = 1.0;             ///< length difference of the displacement, / s^2
-  double w_d = 1.0;             ///< direction difference 1 - d.d'
+  // Coherence g with the neighbouring pairs (Gaussian-weighted means f_l, f_d of their displacements):
+  double w_l = 1.0;             ///< w_l | |d| - f_l | / s: length difference of the displacement
+  double w_d = 2.0;             ///< (w_d / 2)(1 - f_d . d / |d|): direction difference
   int pairing_iterations = 3;   ///< greedy rounds (the first without coherence)
   int max_pairs = 160;          ///< TPS centres (pairs are thinned to one per metric cell)
   double tps_regularization = 1e-6;
@@ -78,10 +79,13 @@ struct PointTextureOptions {
   std::uint64_t seed = 0;
 };
 
-/// Options tuned per built-in exemplar (the paper's Table 1 gives one row per
-/// texture; these are ours): "default", "bumps", "chainmail", "weave",
-/// "flowers". Throws InvalidInput for other names.
+/// Options per built-in exemplar: the pairing weights are the paper's Table 1
+/// rows ("heightfield", also the preset of "bumps" and of height-field
+/// exemplars; "chainmail", "weave", "flowers"), the patch sizes and the
+/// metric's weights ours. "default" (user exemplars) keeps the struct's
+/// defaults. Throws InvalidInput for other names.
 PointTextureOptions point_texture_preset(const std::string& name);
+constexpr const char* kPointPresetNames = "default, heightfield, bumps, chainmail, weave or flowers";
 
 struct PointTextureTimes {
   double search = 0, warp = 0, blend = 0, other = 0;  ///< seconds, as the paper's Table 1

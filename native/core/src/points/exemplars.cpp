@@ -269,26 +269,36 @@ void validate_exemplar(const PointExemplar& ex, const char* what) {
 }
 
 PointTextureOptions point_texture_preset(const std::string& name) {
+  // The weights are the paper's Table 1 rows (w_p = 1): w_n, w_v, w_l, w_d.
   PointTextureOptions o;
-  if (name == "default" || name == "bumps") return o;
+  const auto table1 = [&](double w_n, double w_v, double w_l, double w_d) {
+    o.w_n = w_n, o.w_v = w_v, o.w_l = w_l, o.w_d = w_d;
+  };
+  if (name == "default") return o;
+  if (name == "heightfield" || name == "bumps") {
+    table1(3, 30, 9, 7);
+    return o;
+  }
   if (name == "chainmail") {
+    table1(1, 10, 8, 6);
     o.patch_size = 0.5;  // two ring pitches: a patch carries whole interlocked rings
     o.w_gradient = 0.5;
     o.max_pair_variation = 0.2;
     return o;
   }
   if (name == "weave") {
+    table1(2, 15, 6, 5);
     o.patch_size = 0.5;  // one period of the over-under pattern
     o.w_gradient = 0.5;
     return o;
   }
   if (name == "flowers") {
+    table1(2, 2, 6, 6);
     o.patch_size = 0.45;
-    o.w_n = 0.5;
     o.max_pair_variation = 0.25;
     return o;
   }
-  throw InvalidInput("unknown point-texture preset '" + name + "'; choose default, bumps, chainmail, weave or flowers");
+  throw InvalidInput("unknown point-texture preset '" + name + "'; choose " + std::string(kPointPresetNames));
 }
 
 }  // namespace exsynth

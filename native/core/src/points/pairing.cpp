@@ -48,7 +48,7 @@ std::vector<Candidate> candidate_pairs(const std::vector<PairPoint>& sources, co
         const PairPoint& t = targets[t_idx];
         const double dot = sources[i].n.dot(t.n), dv = std::abs(sources[i].sigma - t.sigma);
         if (double(dist2) > max_d2 || dot < opt.min_normal_dot || dv > opt.max_variation) continue;
-        const float c = float(opt.w_p * double(dist2) / s2 + opt.w_n * (1.0 - dot) + opt.w_v * dv);
+        const float c = float(opt.w_p * double(dist2) / s2 + 0.5 * opt.w_n * (1.0 - dot) + opt.w_v * dv * dv);
         per[i].push_back({std::uint32_t(i), std::uint32_t(t_idx), c, c});
       }
     }
@@ -82,7 +82,7 @@ std::vector<PointPair> greedy_pairs(const std::vector<PairPoint>& sources, const
   if (sources.empty() || targets.empty()) return {};
   std::vector<Candidate> cands = candidate_pairs(sources, targets, opt);
   std::vector<PointPair> pairs = accept_greedily(cands, sources.size(), targets.size());
-  const double s2 = opt.spacing * opt.spacing;
+  const double s = opt.spacing;
   const float r = float(opt.coherence_radius * opt.spacing);
   const double inv_r2 = 1.0 / (double(r) * r);
   for (int round = 1; round < opt.iterations && !pairs.empty(); ++round) {
@@ -106,20 +106,24 @@ std::vector<PointPair> greedy_pairs(const std::vector<PairPoint>& sources, const
         const std::size_t c0 = group[gi], c1 = group[gi + 1];
         const Eigen::Vector3f& sp = sources[cands[c0].source].p;
         index.radius(sp, 2.0f * r, near);  // weights beyond 2 r are below e^-4
+        // The neighbours' Gaussian-weighted mean length f_l and mean direction f_d
+        // (the same for every candidate of this source).
+        double wsum = 0, lsum = 0;
+        Eigen::Vector3d dsum = Eigen::Vector3d::Zero();
+        for (const auto& [k, dist2] : near) {
+          if (pairs[k].source == cands[c0].source) continue;
+          const double w = std::exp(-double(dist2) * inv_r2);
+          lsum += w * double(disp[k].norm());
+          dsum += w * disp[k].template cast<double>();
+          wsum += w;
+        }
+        const double f_l = wsum > 0 ? lsum / wsum : 0.0, dn = dsum.norm();
         for (std::size_t ci = c0; ci < c1; ++ci) {
           Candidate& c = cands[ci];
-          const Eigen::Vector3f d = targets[c.target].p - sp;
+          const Eigen::Vector3d d = (targets[c.target].p - sp).template cast<double>();
           const double len = d.norm();
-          double wsum = 0, g = 0;
-          for (const auto& [k, dist2] : near) {
-            if (pairs[k].source == c.source) continue;
-            const double w = std::exp(-double(dist2) * inv_r2);
-            const double lk = disp[k].norm();
-            const double dir = (len > 1e-12 && lk > 1e-12) ? 1.0 - double(d.dot(disp[k])) / (len * lk) : 0.0;
-            g += w * (opt.w_l * (len - lk) * (len - lk) / s2 + opt.w_d * dir);
-            wsum += w;
-          }
-          c.total = c.base + float(wsum > 0 ? g / wsum : 0.0);
+          const double dir = (len > 1e-12 && dn > 1e-12) ? 1.0 - dsum.dot(d) / (dn * len) : 0.0;
+          c.total = c.base + float(wsum > 0 ? opt.w_l * std::abs(len - f_l) / s + 0.5 * opt.w_d * dir : 0.0);
         }
       }
     });

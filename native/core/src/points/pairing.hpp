@@ -2,10 +2,12 @@
 // Iterated greedy pairing between a patch's overlap points (sources) and the
 // output's points there (targets), the pairs a thin-plate spline warp fits.
 // Round 0 accepts candidate pairs cheapest first, each point at most once,
-// by the cost c = w_p |dp|^2 / s^2 + w_n (1 - n.n') + w_v |sigma - sigma'|
+// by the paper's cost (its Equation 2) with positions in point spacings s:
+// c = w_p |dp|^2 / s^2 + (w_n / 2)(1 - n.n') + w_v (sigma - sigma')^2
 // (thresholds refuse far, misoriented or unlike pairs). Later rounds add the
-// coherence g: how the pair's displacement differs in length (w_l) and
-// direction (w_d) from the accepted pairs around it (Gaussian weights), so
+// paper's coherence g = w_l | |d| - f_l | / s + (w_d / 2)(1 - f_d . d / |d|):
+// f_l and f_d are the Gaussian-weighted mean length and the normalised mean
+// direction of the accepted pairs' displacements around the source, so
 // neighbouring pairs move alike and do not cross.
 #include <cstdint>
 #include <vector>
