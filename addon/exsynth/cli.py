@@ -301,7 +301,9 @@ def _parser():
     p.add_argument("--curve", help="along_curve: the curve as a polyline, .obj (vertices joined by "
                    "'l' lines) or .npy (N by 3), in the files' coordinates")
     p.add_argument("--resolution", type=_int, default=128,
-                   help="voxels along B's longest bounding-box side (default 128)")
+                   help="voxels along B's longest bounding-box side (default 128); with a built-in pair and "
+                   "the pattern size fitted, the least: raised until the pair has "
+                   f"{_native.PAIR_DETAIL_RESOLUTION} voxels across (printed)")
     p.add_argument("--pattern-size", type=_finite, default=None,
                    help="built-in pairs: the pair's cube as a fraction of B's longest side (default: fitted "
                    "to B's thickness, as the add-on's Fit to Model); the pair is made at resolution x "
@@ -417,12 +419,21 @@ def _run_analogy(args):
             raise UsageError(f"--b: {exc} (--pattern-size)")
         print(f"exsynth analogy: pattern size {pattern_scale:.3g} of B's longest side, fitted to its "
               f"thickness {measure['thickness']:.4g}", file=sys.stderr)
+    fitted = bool(args.preset) and args.pattern_size is None
+    resolution = analogy_ops.grid_resolution(args.resolution, pattern_scale, fitted) if args.preset else args.resolution
     job = analogy_ops.GeometricTextureJob(
-        b=b, preset=args.preset or "spikes", resolution=args.resolution,
+        b=b, preset=args.preset or "spikes", resolution=resolution,
         pattern_scale=0.5 if pattern_scale is None else pattern_scale,
         pair_options=_pair_options(args),
         memory_budget=int(args.memory_budget * GIB),
     )
+    if resolution > args.resolution:
+        print(f"exsynth analogy: resolution {resolution} (--resolution {args.resolution} raised so that the pair has "
+              f"{job.pair_resolution} voxels across, which its features need)", file=sys.stderr)
+    elif args.preset and job.pair_resolution < _native.PAIR_DETAIL_RESOLUTION:
+        print(f"exsynth analogy: the pair has {job.pair_resolution} voxels across; its features come out soft "
+              f"under {_native.PAIR_DETAIL_RESOLUTION} (raise --resolution or --pattern-size, or leave "
+              "--pattern-size out to have both fitted)", file=sys.stderr)
     if not args.preset:
         job.a = _analogy_mesh("--a", a_path, field)
         job.a_prime = _analogy_mesh("--a-prime", a_prime_path, None)

@@ -386,7 +386,8 @@ class ExSynthSettings(bpy.types.PropertyGroup):
     geo_resolution: IntProperty(
         name="Resolution",
         description="Voxels along the longest side of the mesh's bounding box (time and memory grow "
-        "with its cube)",
+        "with its cube). With a built-in pair and Fit to Model, the least: a small pattern raises it "
+        "until the pair has the voxels its features need (the panel shows the value used)",
         default=128, min=16, max=512, soft_max=256,
     )
     geo_pattern_fit: BoolProperty(

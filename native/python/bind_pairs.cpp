@@ -58,6 +58,22 @@ void apply_options(PairOptions& o, const py::kwargs& kw) {
 }  // namespace
 
 void bind_pairs(py::module_& m) {
+  m.attr("PAIR_MIN_RESOLUTION") = kMinPairResolution;
+  m.attr("PAIR_MAX_RESOLUTION") = kMaxPairResolution;
+  m.attr("PAIR_DETAIL_RESOLUTION") = kPairDetailResolution;
+  m.attr("MAX_PATTERN_RESOLUTION") = kMaxPatternResolution;
+  m.def(
+      "resolution_for_pattern",
+      [](const IntArg& resolution, const RealArg& pattern_scale, const py::kwargs& extra) {
+        reject_unknown(extra, "resolution, pattern_scale");
+        return resolution_for_pattern(
+            int_arg(resolution, "resolution", 1, kMaxPairResolution * 64, "voxels along B's longest side"),
+            real_arg(pattern_scale, "pattern_scale", 0.0, kInf, Ends::OpenLow, "a fraction of B's longest side"));
+      },
+      py::arg("resolution"), py::arg("pattern_scale"),
+      "B's resolution for a built-in pair covering pattern_scale of B's longest side: resolution, raised\n"
+      "until the pair has PAIR_DETAIL_RESOLUTION voxels across (its features keep their shape), but not\n"
+      "past max(resolution, MAX_PATTERN_RESOLUTION).");
   m.def(
       "check_exemplar_pair",
       [](const StrArg& preset, const IntArg& resolution, const py::kwargs& kw) {

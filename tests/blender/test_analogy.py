@@ -479,7 +479,8 @@ def test_cli_spikes_obj(tmp_path, capsys):
 
 def test_cli_grooves_npy_run_around_the_axis(tmp_path):
     out = tmp_path / "grooves.npy"
-    assert cli.main(["analogy", "--b", BUNNY_OBJ, "--preset", "grooves", "--resolution", "64",
+    # A pattern size by hand keeps the grid at --resolution (h below).
+    assert cli.main(["analogy", "--b", BUNNY_OBJ, "--preset", "grooves", "--resolution", "64", "--pattern-size", "0.6",
                      "--axis", "0", "1", "0", "--out", str(out)]) == 0
     b_prime = np.load(out)
     assert b_prime.dtype == np.float32 and b_prime.ndim == 3
@@ -492,7 +493,7 @@ def test_cli_grooves_npy_run_around_the_axis(tmp_path):
     assert 0.7 < (b_prime < 0).sum() / (b < 0).sum() < 1.0
     # Deterministic: the same run gives the same grid.
     again = tmp_path / "again.npy"
-    assert cli.main(["analogy", "--b", BUNNY_OBJ, "--preset", "grooves", "--resolution", "64",
+    assert cli.main(["analogy", "--b", BUNNY_OBJ, "--preset", "grooves", "--resolution", "64", "--pattern-size", "0.6",
                      "--axis", "0", "1", "0", "--out", str(again)]) == 0
     np.testing.assert_array_equal(np.load(again), b_prime)
 
@@ -549,8 +550,8 @@ def test_cli_field_from_run_field(tmp_path, capsys):
     field = tmp_path / "field.npy"
     assert cli.main(["field", "--mesh", BUNNY_OBJ, "--preset", "along_axis", "--axis", "y", "--out", str(field)]) == 0
     out = tmp_path / "b.npy"
-    assert cli.main(["analogy", "--b", BUNNY_OBJ, "--preset", "grooves", "--resolution", "64", "--axis", "0", "1", "0",
-                     "--field", str(field), "--out", str(out)]) == 0
+    assert cli.main(["analogy", "--b", BUNNY_OBJ, "--preset", "grooves", "--resolution", "64", "--pattern-size", "0.6",
+                     "--axis", "0", "1", "0", "--field", str(field), "--out", str(out)]) == 0
     assert "field field.npy" in capsys.readouterr().out
     verts, faces = read_obj(BUNNY_OBJ)
     h = float((verts.astype(np.float32).max(0) - verts.astype(np.float32).min(0)).max()) / 64

@@ -61,7 +61,7 @@ def test_a_millionth_sized_model_works(tmp_path, capsys):
     assert code == 0, err
     verts, faces = read_obj(out)
     assert len(faces) > 100
-    assert 1e-7 < np.ptp(verts, axis=0).max() < 1e-5
+    assert 1e-7 < np.ptp(verts, axis=0).max() < 2e-5  # the bunny is 9.7e-6 across, plus its spikes
     # A .vdb cannot store such voxels: refused with what to do, nothing written.
     code, err = run(capsys, "voxelize", "--mesh", tiny, "--resolution", "16", "--out", str(tmp_path / "t.vdb"))
     assert code == 2 and "too small for an OpenVDB file" in err and "scale the model up" in err

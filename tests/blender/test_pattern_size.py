@@ -13,9 +13,14 @@ import pytest
 from exsynth import _native, cli
 from exsynth.operators import analogy as analogy_ops
 from exsynth.ui import pattern_preview
-from helpers import COW_OBJ, add_faceless_mesh, world_mesh
+from helpers import COW_OBJ, add_faceless_mesh, read_obj, world_mesh
 
 RESOLUTION = 48
+
+
+def area(verts, tris):
+    v = np.asarray(verts, np.float64)[tris]
+    return float(np.linalg.norm(np.cross(v[:, 1] - v[:, 0], v[:, 2] - v[:, 0]), axis=1).sum() / 2)
 
 
 def settings():
@@ -46,9 +51,23 @@ def test_the_operator_uses_the_shown_size(cow, capfd):
     s.geo_preset = 'SPIKES'
     shown = pattern_preview.pattern_for(bpy.context, cow, wait=True)["scale"]
     assert bpy.ops.exsynth.geometric_texture() == {'FINISHED'}
-    pair = int(re.search(r"pair (\d+)×\1×\1", capfd.readouterr().out).group(1))
-    assert pair == analogy_ops.pair_resolution(RESOLUTION, shown)
+    out = capfd.readouterr().out
+    pair = int(re.search(r"pair (\d+)×\1×\1", out).group(1))
+    # The fitted pattern at 48 would give the pair 13 voxels: the grid is raised until it has the detail's 64.
+    grid = _native.resolution_for_pattern(RESOLUTION, shown)
+    assert grid > RESOLUTION and pair == analogy_ops.pair_resolution(grid, shown) >= _native.PAIR_DETAIL_RESOLUTION
+    dims = [int(d) for d in re.search(r"\((\d+)×(\d+)×(\d+) voxels", out).groups()]
+    assert grid <= max(dims) <= grid + 2 * 40  # B's longest side plus the padding
     assert "cow_spikes" in bpy.data.objects
+
+
+def test_a_pattern_set_by_hand_keeps_the_resolution(cow, capfd):
+    s = settings()
+    s.geo_resolution, s.geo_preset = RESOLUTION, 'SPIKES'
+    s.geo_pattern_fit, s.geo_pattern_scale = False, 0.3
+    assert bpy.ops.exsynth.geometric_texture() == {'FINISHED'}
+    pair = int(re.search(r"pair (\d+)×\1×\1", capfd.readouterr().out).group(1))
+    assert pair == analogy_ops.pair_resolution(RESOLUTION, 0.3)
 
 
 def test_set_by_hand(cow):
@@ -156,6 +175,19 @@ def test_cli_fits_when_no_size_is_given(tmp_path, capsys):
     err = capsys.readouterr().err
     scale = float(re.search(r"pattern size ([\d.]+) of B's longest side, fitted to its thickness", err).group(1))
     assert 0.1 < scale < 0.5 and out.exists()
+    raised, pair = map(int, re.search(r"resolution (\d+) \(--resolution 48 raised so that the pair has (\d+) "
+                                      r"voxels", err).groups())
+    assert raised > RESOLUTION and _native.PAIR_DETAIL_RESOLUTION <= pair <= _native.PAIR_DETAIL_RESOLUTION + 1
+    # Spikes, not lumps, on a model the pattern was fitted to: the pair alone adds 27 % of the area it
+    # covers at 64 voxels; the cow gets more than 25 % (measured 41 %; 13 % before the grid followed).
+    assert area(*read_obj(str(out))) > 1.25 * area(*read_obj(COW_OBJ))
+
+
+def test_cli_warns_when_a_hand_set_pattern_is_too_small_for_the_grid(tmp_path, capsys):
+    assert cli.main(["analogy", "--b", COW_OBJ, "--preset", "spikes", "--resolution", str(RESOLUTION),
+                     "--pattern-size", "0.3", "--out", str(tmp_path / "c.obj")]) == 0
+    pair = analogy_ops.pair_resolution(RESOLUTION, 0.3)
+    assert f"the pair has {pair} voxels across; its features come out soft under 64" in capsys.readouterr().err
 
 
 class _Region:

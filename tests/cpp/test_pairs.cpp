@@ -399,3 +399,25 @@ TEST(PairTest, SpikeDistancesOutsideMatchADenseSurfaceSampling) {
       }
   EXPECT_GT(checked, 100);
 }
+
+TEST(ResolutionForPattern, IsTheLeastResolutionThatGivesThePairItsDetail) {
+  // Brute force: the first r from `resolution` up whose pair has the detail
+  // voxels, or the cap.
+  auto by_hand = [](int resolution, double scale) {
+    const int top = std::max(resolution, kMaxPatternResolution);
+    for (int r = resolution; r < top; ++r)
+      if (std::lround(scale * r) >= kPairDetailResolution) return r;
+    return top;
+  };
+  for (int resolution : {1, 16, 96, 128, 200, 256, 511, 512, 700})
+    for (double scale : {0.01, 0.05, 0.1, 0.125, 0.2231, 0.25, 0.276, 0.3333, 0.5, 0.575, 1.0, 4.0}) {
+      const int r = resolution_for_pattern(resolution, scale);
+      EXPECT_EQ(r, by_hand(resolution, scale)) << resolution << " x " << scale;
+      EXPECT_GE(r, resolution);
+    }
+  EXPECT_EQ(resolution_for_pattern(128, 0.575), 128);  // the bunny's fitted pattern already has 74 voxels
+  EXPECT_GT(resolution_for_pattern(128, 0.276), 128);  // the cow's 35 do not
+  EXPECT_THROW(resolution_for_pattern(0, 0.5), InvalidInput);
+  EXPECT_THROW(resolution_for_pattern(128, 0.0), InvalidInput);
+  EXPECT_THROW(resolution_for_pattern(128, std::nan("")), InvalidInput);
+}

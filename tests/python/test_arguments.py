@@ -102,6 +102,8 @@ FUNCTIONS = {
     "voxel_grid": (call("voxel_grid", (0, 0, 0), (1, 2, 3)), {
         "resolution": ("int", 1, 2 ** 14), "voxel_size": ("real", 0, None), "padding": ("int", 0, 1024)}),
     "analogy_padding": (call("analogy_padding"), {"fine_size": ("int", 3, 9), "coarse_size": ("int", 1, 7)}),
+    "resolution_for_pattern": (call("resolution_for_pattern", resolution=128, pattern_scale=0.3), {
+        "resolution": ("int", 1, 2 ** 15), "pattern_scale": ("real", 0, None)}),
     "validate_mesh": (call("validate_mesh", VERTS, FACES), {"name": "str"}),
     "point_texture_preset": (call("point_texture_preset"), {"name": "str"}),
     "make_point_exemplar": (lambda **over: _native.make_point_exemplar(**{"name": "bumps", "density": 200.0, **over}), {

@@ -103,3 +103,19 @@ def test_check_exemplar_pair_refuses_what_make_would(preset, options, message):
 def test_check_exemplar_pair_accepts_the_defaults():
     for preset in ("spikes", "pits", "holes", "grooves", "dilate"):
         assert _native.check_exemplar_pair(preset) is None
+
+
+def test_resolution_for_pattern_gives_the_pair_its_detail():
+    detail = _native.PAIR_DETAIL_RESOLUTION
+    assert _native.PAIR_MIN_RESOLUTION <= detail <= _native.PAIR_MAX_RESOLUTION
+    for resolution, scale in ((128, 0.276), (48, 0.5), (128, 0.223), (16, 1.0)):
+        r = _native.resolution_for_pattern(resolution, scale)
+        assert r > resolution and round(scale * r) >= detail > round(scale * (r - 1))  # the least such r
+    assert _native.resolution_for_pattern(128, 0.575) == 128  # already 74 voxels across
+    assert _native.resolution_for_pattern(128, 0.01) == _native.MAX_PATTERN_RESOLUTION  # capped
+    with pytest.raises(_native.InvalidInputError, match="pattern_scale"):
+        _native.resolution_for_pattern(128, 0.0)
+    with pytest.raises(_native.InvalidInputError, match="resolution"):
+        _native.resolution_for_pattern(0, 0.5)
+    with pytest.raises(_native.InvalidInputError, match="unknown"):
+        _native.resolution_for_pattern(128, 0.5, scale=2)

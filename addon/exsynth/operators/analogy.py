@@ -32,7 +32,7 @@ from . import field as field_ops
 
 PRESETS = ("spikes", "pits", "holes", "grooves", "dilate")
 FIELD_PRESETS = tuple(field_ops.PRESETS.values())  # around_axis, along_axis, along_curve
-PAIR_MIN, PAIR_MAX = 8, 512  # make_exemplar_pair's resolution range
+PAIR_MIN, PAIR_MAX = _native.PAIR_MIN_RESOLUTION, _native.PAIR_MAX_RESOLUTION  # make_exemplar_pair's range
 PATTERN_SCALE_MIN, PATTERN_SCALE_MAX = 0.05, 4.0  # the panel's Pattern Size range
 MAX_GRID_SIDE = 2048  # voxels along one side of a user pair's grid
 
@@ -51,6 +51,15 @@ def pair_resolution(resolution, pattern_scale):
     that is the pair's resolution. Depends only on the two settings, so it
     is known (and checked) before anything runs."""
     return int(round(pattern_scale * resolution))
+
+
+def grid_resolution(resolution, pattern_scale, fitted):
+    """B's voxels along its longest side for a built-in pair: with the
+    pattern fitted to the model, the Resolution raised (the engine's rule,
+    _native.resolution_for_pattern) until the pair has the voxels its
+    features need, so a small pattern on a coarse grid makes spikes, not
+    lumps; a pattern size set by hand keeps the Resolution as given."""
+    return _native.resolution_for_pattern(resolution, pattern_scale) if fitted else resolution
 
 
 def fitted_pattern_scale(vertices, triangles, resolution):
@@ -526,7 +535,8 @@ class EXSYNTH_OT_geometric_texture(JobOperator, bpy.types.Operator):
         if fit:  # the value the panel shows (ui/pattern_preview.py measures the same mesh)
             scale, _ = fitted_pattern_scale(b.vertices, b.triangles, settings.geo_resolution)
         job = GeometricTextureJob(
-            b=b, preset=settings.geo_preset.lower(), resolution=settings.geo_resolution,
+            b=b, preset=settings.geo_preset.lower(),
+            resolution=grid_resolution(settings.geo_resolution, scale, fit) if builtin else settings.geo_resolution,
             pattern_scale=scale, pair_options=pair_options(settings),
             memory_budget=settings.memory_budget_bytes,
         )

@@ -3,10 +3,13 @@
 
 import bpy
 
-from ..operators.analogy import PAIR_MAX, PAIR_MIN, pair_resolution
+from .. import _native
+from ..operators.analogy import PAIR_MAX, PAIR_MIN, grid_resolution, pair_resolution
 from ..operators.field import FIELD_ATTRIBUTE
 from ..ui.pattern_preview import length_text, pattern_for
 from .main import SidebarPanel, draw_field_preset, draw_shared_advanced
+
+PAIR_DETAIL = _native.PAIR_DETAIL_RESOLUTION  # the pair's voxels from which its features keep their shape
 
 
 def _is_mesh(obj):
@@ -78,11 +81,16 @@ class EXSYNTH_PT_geometric_texture(SidebarPanel, bpy.types.Panel):
             pair = settings.geo_preset.lower() if builtin else getattr(settings.geo_a_prime, "name", "A′")
             box.label(text=f"{obj.name} → {obj.name}_{pair}", icon='MESH_DATA')
         if builtin and pattern and "scale" in pattern:
-            r_pair = pair_resolution(settings.geo_resolution, pattern["scale"])
+            grid = grid_resolution(settings.geo_resolution, pattern["scale"], settings.geo_pattern_fit)
+            r_pair = pair_resolution(grid, pattern["scale"])
             if not PAIR_MIN <= r_pair <= PAIR_MAX:
                 box.label(text=f"Pair {r_pair}³: needs {PAIR_MIN} to {PAIR_MAX}", icon='ERROR')
             else:
                 box.label(text=f"Exemplar pair {r_pair}³ voxels")
+            if grid > settings.geo_resolution:  # the consequence, before the run
+                box.label(text=f"Runs at {grid} voxels: the pattern's detail needs them", icon='INFO')
+            if r_pair < PAIR_DETAIL:
+                box.label(text=f"Soft features under {PAIR_DETAIL}: raise Resolution or Pattern Size", icon='ERROR')
         elif settings.geo_a is None or settings.geo_a_prime is None:
             box.label(text="Pick A and A′ (meshes)", icon='ERROR')
         row = layout.row()

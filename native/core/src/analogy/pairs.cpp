@@ -196,6 +196,22 @@ struct Shapes {
 
 }  // namespace
 
+int resolution_for_pattern(int resolution, double pattern_scale) {
+  if (resolution < 1) throw InvalidInput("resolution must be at least 1 voxel, got " + std::to_string(resolution));
+  if (!(pattern_scale > 0) || !std::isfinite(pattern_scale))
+    throw InvalidInput("pattern_scale must be a positive fraction of B's longest side, got " +
+                       std::to_string(pattern_scale));
+  if (std::lround(pattern_scale * resolution) >= kPairDetailResolution) return resolution;
+  // The least r with round(pattern_scale * r) >= kPairDetailResolution,
+  // from the estimate, stepped to the exact rounding.
+  const int top = std::max(resolution, kMaxPatternResolution);
+  const double need = std::ceil((kPairDetailResolution - 0.5) / pattern_scale);
+  int r = int(std::clamp(need, double(resolution), double(top)));
+  while (r < top && std::lround(pattern_scale * r) < kPairDetailResolution) ++r;
+  while (r > resolution && std::lround(pattern_scale * (r - 1)) >= kPairDetailResolution) --r;
+  return r;
+}
+
 const char* pair_preset_name(PairPreset preset) {
   switch (preset) {
     case PairPreset::Spikes: return "spikes";
