@@ -425,7 +425,7 @@ def _run_analogy(args):
         b=b, preset=args.preset or "spikes", resolution=resolution,
         pattern_scale=0.5 if pattern_scale is None else pattern_scale,
         pair_options=_pair_options(args),
-        memory_budget=int(args.memory_budget * GIB),
+        memory_budget=int(args.memory_budget * GIB), asked_resolution=args.resolution,
     )
     if resolution > args.resolution:
         print(f"exsynth analogy: resolution {resolution} (--resolution {args.resolution} raised so that the pair has "
@@ -446,7 +446,11 @@ def _run_analogy(args):
             analogy_ops.check_user_pair_grid(b.vertices, job.a.vertices, job.a_prime.vertices, args.resolution)
         except jobs.InputError as exc:
             raise UsageError(f"--a/--a-prime: {str(exc).replace('Resolution', '--resolution')}")
-    result, seconds = _run_job(job, "analogy")
+    try:
+        result, seconds = _run_job(job, "analogy")
+    except _native.OverBudgetError as exc:
+        raise _native.OverBudgetError(str(exc).replace("set a larger Pattern Size by hand",
+                                                       "give a larger --pattern-size")) from None
 
     if out_ext == ".obj":
         export_obj(out, analogy_ops.result_name(result), *result.surface)
@@ -1139,8 +1143,8 @@ def _run_points(args):
     result, seconds = _run_job(job, "points")
     point_files.write_points(out, result.positions, result.normals)
     t = result.stats["times"]
-    line = (f"points: {exemplar.name} ({preset} weights) -> {len(result.positions)} points, {result.stats['patches']} patches, "
-            f"{result.stats['pairs']} pairs (search {t['search']:.2f} s, warp {t['warp']:.2f} s, blend "
+    line = (f"points: {exemplar.name} ({preset} weights) -> {len(result.positions)} points, "
+            f"{result.stats['patches']} patches, {result.stats['pairs']} pairs (search {t['search']:.2f} s, warp {t['warp']:.2f} s, blend "
             f"{t['blend']:.2f} s, other {t['other']:.2f} s) in {seconds:.2f} s -> {args.out}")
     if mesh_out:
         export_obj(mesh_out, result.name.replace("_points", "_surface"), *result.surface)

@@ -446,6 +446,13 @@ def test_user_pair_a_without_faces():
 
 def test_over_the_memory_budget(bunny):
     run_expecting_error(r"over the memory budget.*lower the resolution", geo_resolution=64,
+                        geo_pattern_fit=False, geo_pattern_scale=0.5, memory_budget_gib=0.001)
+
+
+def test_over_the_memory_budget_at_a_raised_resolution_says_the_pattern_size(bunny):
+    """Lowering the Resolution would not help: the fitted pattern raised it."""
+    run_expecting_error(r"over the memory budget of [\d.]+ MiB; set a larger Pattern Size by hand \(the fitted one raised the "
+                        r"resolution from 64 to \d+ for its detail\) or raise the memory budget", geo_resolution=64,
                         memory_budget_gib=0.001)
 
 

@@ -183,6 +183,14 @@ def test_cli_fits_when_no_size_is_given(tmp_path, capsys):
     assert area(*read_obj(str(out))) > 1.25 * area(*read_obj(COW_OBJ))
 
 
+def test_cli_over_the_budget_at_a_raised_resolution_names_the_pattern_size(tmp_path, capsys):
+    out = tmp_path / "c.obj"
+    assert cli.main(["analogy", "--b", COW_OBJ, "--preset", "spikes", "--resolution", str(RESOLUTION),
+                     "--memory-budget", "0.001", "--out", str(out)]) == 1
+    assert "give a larger --pattern-size (the fitted one raised the resolution from 48 to" in capsys.readouterr().err
+    assert not out.exists()
+
+
 def test_cli_warns_when_a_hand_set_pattern_is_too_small_for_the_grid(tmp_path, capsys):
     assert cli.main(["analogy", "--b", COW_OBJ, "--preset", "spikes", "--resolution", str(RESOLUTION),
                      "--pattern-size", "0.3", "--out", str(tmp_path / "c.obj")]) == 0

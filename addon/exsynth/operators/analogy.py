@@ -85,14 +85,14 @@ def voxel_size_for(vertices, resolution):
     return _native.voxel_grid(v.min(axis=0), v.max(axis=0), resolution=resolution, padding=0)["voxel_size"]
 
 
-def _voxelize(role, vertices, triangles, **options):
+def _voxelize(role, vertices, triangles, fix="lower the resolution", **options):
     """_native.voxelize at B's voxel size; over budget, the message says what
-    the user can change (the resolution; the voxel size is derived from it)."""
+    the user can change (`fix`: the resolution by default, as the voxel size is derived from it)."""
     try:
         return _native.voxelize(vertices, triangles, **options)
     except _native.OverBudgetError as exc:
         need = str(exc).split(";")[0]
-        raise _native.OverBudgetError(f"{role}: {need}; lower the resolution or raise the memory budget") from None
+        raise _native.OverBudgetError(f"{role}: {need}; {fix} or raise the memory budget") from None
 
 
 # ---- plain data handed to the worker -------------------------------------------
@@ -177,6 +177,7 @@ class GeometricTextureJob(Job):
     pattern_scale: float = 0.5  # built-in pairs only
     pair_options: dict = dataclasses.field(default_factory=dict)
     memory_budget: int = 0  # bytes; 0 = the engine's default
+    asked_resolution: int = 0  # the user's Resolution, when a fitted pattern raised it (grid_resolution)
 
     label = "geometric texture"
 
@@ -210,7 +211,11 @@ class GeometricTextureJob(Job):
             padding = self.padding()
             region = None
         self.share(ctx, 0.15, 0.22)
-        grid = _voxelize("B", self.b.vertices, self.b.triangles, voxel_size=h, padding=padding, **common)
+        fix = "lower the resolution"
+        if self.resolution > self.asked_resolution:
+            fix = (f"set a larger Pattern Size by hand (the fitted one raised the resolution from "
+                   f"{self.asked_resolution} to {self.resolution} for its detail)")
+        grid = _voxelize("B", self.b.vertices, self.b.triangles, fix=fix, voxel_size=h, padding=padding, **common)
         b, origin = grid["sdf"], grid["origin"]
         field_b = self.b.field.frames_t(self.b, grid, ctx, span=(0.22, 0.27))
         if not self.user_pair:
@@ -538,7 +543,7 @@ class EXSYNTH_OT_geometric_texture(JobOperator, bpy.types.Operator):
             b=b, preset=settings.geo_preset.lower(),
             resolution=grid_resolution(settings.geo_resolution, scale, fit) if builtin else settings.geo_resolution,
             pattern_scale=scale, pair_options=pair_options(settings),
-            memory_budget=settings.memory_budget_bytes,
+            memory_budget=settings.memory_budget_bytes, asked_resolution=settings.geo_resolution,
         )
         if settings.geo_pair_source == 'OBJECTS':
             job.a, job.a_prime = user_pair(context, settings, b)
