@@ -218,3 +218,40 @@ def test_the_sphere_shows_only_with_the_exsynth_sidebar():
     assert shows(*_view(True, _Region('UI', 'UNSUPPORTED')))  # not drawn yet
     assert not shows(None, None)  # drawn outside a 3D view's area
     assert not shows(*_view(True, _Region('WINDOW')))
+
+
+class _Recorder:
+    """Stands in for a panel's layout: every call returns itself; labels are kept."""
+
+    def __init__(self, labels):
+        self.labels = labels
+
+    def label(self, text="", **_):
+        self.labels.append(text)
+
+    def __getattr__(self, name):
+        return lambda *a, **k: self
+
+
+def _panel_labels():
+    from exsynth.panels.analogy import EXSYNTH_PT_geometric_texture
+
+    labels = []
+    EXSYNTH_PT_geometric_texture.draw(types.SimpleNamespace(layout=_Recorder(labels),
+                                                            _layout=lambda: _Recorder(labels)), bpy.context)
+    return labels
+
+
+def test_the_panel_shows_the_raised_resolution_before_the_run(cow):
+    s = settings()
+    s.geo_resolution, s.geo_pair_source = RESOLUTION, 'BUILTIN'
+    scale = pattern_preview.pattern_for(bpy.context, cow, wait=True)["scale"]
+    grid = _native.resolution_for_pattern(RESOLUTION, scale)
+    labels = _panel_labels()
+    assert f"Runs at {grid} voxels: the pattern's detail needs them" in labels
+    assert f"Exemplar pair {analogy_ops.pair_resolution(grid, scale)}³ voxels" in labels
+    s.geo_pattern_fit, s.geo_pattern_scale = False, 0.3  # by hand: kept, and said to be soft
+    pattern_preview.pattern_for(bpy.context, cow, wait=True)
+    labels = _panel_labels()
+    assert not any(text.startswith("Runs at") for text in labels)
+    assert "Soft features under 64: raise Resolution or Pattern Size" in labels
