@@ -174,8 +174,7 @@ def _parser():
     p.add_argument("--padding", type=_int, default=2, help="empty voxels on every side (default 2)")
     p.add_argument("--supersample", type=_int, default=2, help="sub-rays per voxel edge, 1..8 (default 2)")
     p.add_argument("--mesh-out", help="also write the rebuilt surface (zero level of the sdf) as .obj")
-    p.add_argument("--memory-budget", type=_gib, default=0.0,
-                   help="refuse jobs needing more than this many GiB (default: the engine's 8 GiB)")
+    _add_memory_budget(p)
     p.set_defaults(run=_run_voxelize)
 
     p = sub.add_parser(
@@ -229,13 +228,13 @@ def _parser():
     p.add_argument("--mesh", help="also bake the solid onto this mesh (.obj, .ply, .stl; unwrapped with "
                    "Smart UV Project when it has no UVs)")
     p.add_argument("--bake-out", help="the baked texture (.png), with --mesh")
-    p.add_argument("--bake-size", type=_int, help="with --mesh: baked texture width and height (default 512)")
+    p.add_argument("--bake-size", type=_int, help="with --mesh: baked texture width and height "
+                   f"(default {_native.BAKE_DEFAULT_SIZE})")
     p.add_argument("--bake-interpolation", choices=_native.INTERPOLATION_CHOICES,
                    help="with --mesh: how texels read the solid between voxels; cubic keeps voxel-sized detail's "
                    f"contrast, linear is softer (default {_native.DEFAULT_INTERPOLATION})")
     p.add_argument("--mesh-out", help="with --mesh: write the mesh with the UV map the bake used (.obj)")
-    p.add_argument("--memory-budget", type=_gib, default=0.0,
-                   help="refuse jobs needing more than this many GiB (default: the engine's 8 GiB)")
+    _add_memory_budget(p)
     p.set_defaults(run=_run_solid)
 
     p = sub.add_parser(
@@ -257,8 +256,7 @@ def _parser():
                    help=f"with --method optimization: rounds per level (default {_native.DEFAULT_ITERATIONS})")
     p.add_argument("--seed", type=_seed, default=0, help="random seed (default 0)")
     p.add_argument("--alpha", action="store_true", help="synthesize the exemplar's alpha too")
-    p.add_argument("--memory-budget", type=_gib, default=0.0,
-                   help="refuse jobs needing more than this many GiB (default: the engine's 8 GiB)")
+    _add_memory_budget(p)
     p.set_defaults(run=_run_image)
 
     p = sub.add_parser(
@@ -315,8 +313,7 @@ def _parser():
                    help=f"with --preset dilate: A' radius minus A's (default {analogy_ops.DEFAULT_GROWTH['dilation']:g})")
     p.add_argument("--spike-height", type=_finite,
                    help=f"with --preset spikes: cone height (default {analogy_ops.DEFAULT_GROWTH['feature_height']:g})")
-    p.add_argument("--memory-budget", type=_gib, default=0.0,
-                   help="refuse jobs needing more than this many GiB (default: the engine's 8 GiB)")
+    _add_memory_budget(p)
     p.set_defaults(run=_run_analogy)
 
     p = sub.add_parser("demo", help="voxelize the bundled bunny, solid-texture the cow, give the bunny "
@@ -581,7 +578,7 @@ def _run_solid(args):
     for flag, value in (("--mesh-out", args.mesh_out), ("--bake-size", args.bake_size),
                         ("--bake-interpolation", args.bake_interpolation)):
         _goes_with(flag, value is not None, args.mesh, "--mesh")
-    args.bake_size = 512 if args.bake_size is None else args.bake_size
+    args.bake_size = _native.BAKE_DEFAULT_SIZE if args.bake_size is None else args.bake_size
     args.bake_interpolation = args.bake_interpolation or _native.DEFAULT_INTERPOLATION
     if args.mesh:
         mesh_path = _input_file("--mesh", args.mesh, MESH_FORMATS)
@@ -845,6 +842,12 @@ def _gib(text):
     return value
 
 
+def _add_memory_budget(p):
+    p.add_argument("--memory-budget", type=_gib, default=0.0,
+                   help="refuse jobs needing more than this many GiB (default: the engine's "
+                   f"{_native.DEFAULT_MEMORY_BUDGET / GIB:g} GiB)")
+
+
 def _goes_with(flag, given, ok, partner):
     """Refuse `flag` where it would do nothing: it goes with `partner`."""
     _require(not given or ok, f"{flag} goes with {partner}; here it would have no effect")
@@ -908,8 +911,7 @@ def _add_surface_parser(sub):
     p.add_argument("--texture-out", required=True, help="the atlas: .png")
     p.add_argument("--height-out", help="with --height: the height atlas, .png")
     p.add_argument("--seed", type=_seed, default=0, help="random seed (default 0)")
-    p.add_argument("--memory-budget", type=_gib, default=0.0,
-                   help="refuse jobs needing more than this many GiB (default: the engine's 8 GiB)")
+    _add_memory_budget(p)
     p.set_defaults(run=_run_surface)
 
 
@@ -1018,7 +1020,7 @@ def _points_parser(sub):
     p.add_argument("--out", required=True, help="the points: .ply (binary, with normals) or .obj (v + vn)")
     p.add_argument("--mesh-out", help="also a surface made from the points: .obj")
     p.add_argument("--seed", type=_seed, default=0, help="random seed (default 0)")
-    p.add_argument("--memory-budget", type=_gib, default=0.0, help="GiB (default: the engine's 8 GiB)")
+    _add_memory_budget(p)
     p.set_defaults(run=_run_points)
 
 

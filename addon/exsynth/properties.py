@@ -221,7 +221,7 @@ class ExSynthSettings(bpy.types.PropertyGroup):
     solid_bake_resolution: IntProperty(
         name="Resolution",
         description="Width and height of each baked image, in pixels",
-        default=1024, min=16, max=16384, soft_max=8192,
+        default=_native.BAKE_DEFAULT_SIZE, min=16, max=_native.BAKE_MAX_SIZE, soft_max=8192,
     )
     solid_bake_interpolation: EnumProperty(
         name="Interpolation",
@@ -411,14 +411,15 @@ class ExSynthSettings(bpy.types.PropertyGroup):
     )
     geo_dilation: FloatProperty(
         name="Dilation",
-        description="Dilate: how much larger A′'s sphere is than A's (radius 0.5 in the exemplar's "
-        "[-1, 1] cube; 0.15 moves the surface out by 15 % of half the pattern size)",
-        default=0.15, min=0.02, max=0.4, precision=3,
+        description=f"Dilate: how much larger A′'s sphere is than A's (radius "
+        f"{_native.PAIR_DEFAULTS['sphere_radius']:g} in the exemplar's [-1, 1] cube; 0.15 moves the surface "
+        "out by 15 % of half the pattern size)",
+        default=_native.PAIR_DEFAULTS["dilation"], min=0.02, max=0.4, precision=3,
     )
     geo_spike_height: FloatProperty(
         name="Spike Height",
         description="Spikes: the cones' height in the exemplar's [-1, 1] cube",
-        default=0.3, min=0.05, max=0.5, precision=3,
+        default=_native.PAIR_DEFAULTS["feature_height"], min=0.05, max=0.5, precision=3,
     )
     geo_make_volume: BoolProperty(
         name="Make Volume",

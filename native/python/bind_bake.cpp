@@ -48,6 +48,8 @@ void bind_bake(py::module_& m) {
   m.attr("INTERPOLATION_CHOICES") = py::tuple(py::cast(interpolation_names()));
   const std::string default_interp = interpolation_names()[std::size_t(kDefaultInterpolation)];
   m.attr("DEFAULT_INTERPOLATION") = default_interp;
+  m.attr("BAKE_DEFAULT_SIZE") = BakeOptions{}.width;
+  m.attr("BAKE_MAX_SIZE") = kMaxBakeSize;
   m.def(
       "sample_volume",
       [](const ArrayArg& volume, const Vec3Arg& origin, const RealArg& voxel_size, const ArrayArg& points,

@@ -62,6 +62,19 @@ void bind_pairs(py::module_& m) {
   m.attr("PAIR_MAX_RESOLUTION") = kMaxPairResolution;
   m.attr("PAIR_DETAIL_RESOLUTION") = kPairDetailResolution;
   m.attr("MAX_PATTERN_RESOLUTION") = kMaxPatternResolution;
+  {  // The shape options' defaults (world units on the pair's [-1, 1] cube), as make_exemplar_pair takes them.
+    const PairOptions d;
+    py::dict defaults;
+    defaults["thickness"] = d.thickness;
+    defaults["spacing"] = d.spacing;
+    defaults["feature_radius"] = d.feature_radius;
+    defaults["feature_height"] = d.feature_height;
+    defaults["jitter"] = d.jitter;
+    defaults["cylinder_radius"] = d.cylinder_radius;
+    defaults["sphere_radius"] = d.sphere_radius;
+    defaults["dilation"] = d.dilation;
+    m.attr("PAIR_DEFAULTS") = defaults;
+  }
   m.def(
       "resolution_for_pattern",
       [](const IntArg& resolution, const RealArg& pattern_scale, const py::kwargs& extra) {

@@ -91,3 +91,17 @@ def test_a_module_for_another_python_fails_to_enable_with_one_line_naming_the_zi
     assert "\n" not in message and platforms.extension_zip("0.1.0", here) in message
     assert raised.value.__cause__ is None and raised.value.__suppress_context__
     assert set(dir(bpy.types)) == classes_before
+
+
+def test_defaults_and_limits_that_come_from_the_engine():
+    from exsynth import _native, cli
+
+    rna = bpy.context.scene.exsynth.bl_rna.properties
+    assert rna["geo_spike_height"].default == pytest.approx(_native.PAIR_DEFAULTS["feature_height"])
+    assert rna["geo_dilation"].default == pytest.approx(_native.PAIR_DEFAULTS["dilation"])
+    assert (rna["solid_bake_resolution"].default, rna["solid_bake_resolution"].hard_max) == (
+        _native.BAKE_DEFAULT_SIZE, _native.BAKE_MAX_SIZE)
+    # The CLI bakes at the same default size as the panel.
+    help_text = cli._parser()._subparsers._group_actions[0].choices["solid"].format_help()
+    assert f"(default {_native.BAKE_DEFAULT_SIZE})" in " ".join(help_text.split())
+    assert f"the engine's {_native.DEFAULT_MEMORY_BUDGET / 2 ** 30:g} GiB" in " ".join(help_text.split())

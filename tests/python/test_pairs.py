@@ -119,3 +119,13 @@ def test_resolution_for_pattern_gives_the_pair_its_detail():
         _native.resolution_for_pattern(0, 0.5)
     with pytest.raises(_native.InvalidInputError, match="unknown"):
         _native.resolution_for_pattern(128, 0.5, scale=2)
+
+
+@pytest.mark.parametrize("preset", PRESETS)
+def test_the_exported_defaults_are_the_ones_the_pair_uses(preset):
+    plain = _native.make_exemplar_pair(preset, resolution=24)
+    given = _native.make_exemplar_pair(preset, resolution=24, **_native.PAIR_DEFAULTS)
+    np.testing.assert_array_equal(plain["a_prime"], given["a_prime"])
+    changed = _native.make_exemplar_pair(preset, resolution=24, **{**_native.PAIR_DEFAULTS,
+                                                                    "feature_radius": 0.1, "dilation": 0.2})
+    assert not np.array_equal(plain["a_prime"], changed["a_prime"])

@@ -39,7 +39,7 @@ MAX_GRID_SIDE = 2048  # voxels along one side of a user pair's grid
 # How far A' reaches beyond A in the pair's own units (the pair spans
 # [-1, 1]^3): the grid around B needs that much room to grow into.
 _PAIR_GROWTH = {"spikes": "feature_height", "dilate": "dilation"}
-DEFAULT_GROWTH = {"feature_height": 0.3, "dilation": 0.15}
+DEFAULT_GROWTH = {key: _native.PAIR_DEFAULTS[key] for key in _PAIR_GROWTH.values()}  # the engine's
 
 
 def pair_resolution(resolution, pattern_scale):
