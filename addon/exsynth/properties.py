@@ -132,18 +132,18 @@ class ExSynthSettings(bpy.types.PropertyGroup):
         f"{_native.min_texture_size(1)} with 1",
         default=_native.SOLID_DEFAULT_SIZE, min=_native.min_texture_size(1),
         soft_min=_native.min_texture_size(SOLID_DEFAULT_LEVELS),
-        max=256,
+        max=_native.SOLID_MAX_SIZE, soft_max=256,
     )
     solid_levels: IntProperty(
         name="Levels",
         description="Coarse-to-fine levels; the coarsest (Size / 2^(Levels-1)) and the exemplar at "
         "that level must be at least 8 pixels across",
-        default=SOLID_DEFAULT_LEVELS, min=1, max=6,
+        default=SOLID_DEFAULT_LEVELS, min=1, max=_native.MAX_LEVELS, soft_max=6,
     )
     solid_iterations: IntProperty(
         name="Iterations",
         description="Optimisation rounds per level (more: closer to the exemplar, slower)",
-        default=_native.DEFAULT_ITERATIONS, min=1, max=20,
+        default=_native.DEFAULT_ITERATIONS, min=1, max=_native.MAX_ITERATIONS, soft_max=20,
     )
     solid_method: EnumProperty(
         name="Method",

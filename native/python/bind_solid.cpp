@@ -39,9 +39,9 @@ void set_common(TextureOptimizationOptions& o, const py::kwargs& kw, const std::
     const std::string k = py::str(item.first);
     const py::handle v = item.second;
     // Ranges as solid/synthesize.cpp's check_options (which checks them again).
-    if (k == "levels") o.levels = int_arg(v, k, 1, 8);
+    if (k == "levels") o.levels = int_arg(v, k, 1, kMaxLevels);
     else if (k == "neighborhood") o.neighborhood = int_arg(v, k, 3, 32);
-    else if (k == "iterations") o.iterations = int_arg(v, k, 1, 100);
+    else if (k == "iterations") o.iterations = int_arg(v, k, 1, kMaxIterations);
     else if (k == "finest_iterations") o.finest_iterations = int_arg(v, k, -1, 100);
     else if (k == "r") o.r = real_arg(v, k, 0.0, 2.0, Ends::OpenLow);
     else if (k == "pca_variance") o.pca_variance = real_arg(v, k, 0.0, 1.0, Ends::OpenLow);
@@ -180,7 +180,7 @@ void bind_solid(py::module_& m) {
       [](const IntArg& levels, const IntArg& neighborhood, const py::kwargs& extra) {
         reject_unknown(extra, "levels, neighborhood");
         // Ranges as set_common's (solid/synthesize.cpp's check_options).
-        return min_texture_size(int_arg(levels, "levels", 1, 8), int_arg(neighborhood, "neighborhood", 3, 32));
+        return min_texture_size(int_arg(levels, "levels", 1, kMaxLevels), int_arg(neighborhood, "neighborhood", 3, 32));
       },
       py::arg("levels") = TextureOptimizationOptions{}.levels,
       py::arg("neighborhood") = TextureOptimizationOptions{}.neighborhood,
@@ -189,6 +189,8 @@ void bind_solid(py::module_& m) {
   // The engine's defaults, for the add-on's properties and the CLI's options.
   m.attr("DEFAULT_LEVELS") = TextureOptimizationOptions{}.levels;
   m.attr("DEFAULT_ITERATIONS") = TextureOptimizationOptions{}.iterations;
+  m.attr("MAX_LEVELS") = kMaxLevels;
+  m.attr("MAX_ITERATIONS") = kMaxIterations;
   m.attr("SOLID_DEFAULT_SIZE") = SolidOptions{}.size;
   m.attr("SOLID_DEFAULT_FEATURE_WEIGHT") = SolidOptions{}.feature_weight;
   m.attr("SOLID_DEFAULT_HISTOGRAM_VALUES") = SolidOptions{}.histogram_values;

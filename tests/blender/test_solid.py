@@ -116,8 +116,12 @@ def test_operators_panels_and_settings_are_registered():
     assert (args.size, args.levels, args.iterations) == engine
     rna = s.bl_rna.properties["solid_size"]
     # The engine's size rule: 1 level allows the hard min, the default levels the soft min.
-    assert (rna.hard_min, rna.hard_max) == (_native.min_texture_size(1), 256)
+    assert (rna.hard_min, rna.hard_max) == (_native.min_texture_size(1), _native.SOLID_MAX_SIZE)
     assert rna.soft_min == _native.min_texture_size(s.solid_levels) > rna.hard_min
+    # One range per option: the engine's; the sliders stop earlier (soft maximum).
+    for name, hard in (("solid_levels", _native.MAX_LEVELS), ("solid_iterations", _native.MAX_ITERATIONS)):
+        rna = s.bl_rna.properties[name]
+        assert rna.hard_max == hard and rna.soft_max <= hard
     assert s.solid_exemplar is None and s.solid_volume is None
 
 

@@ -29,6 +29,9 @@ namespace exsynth {
 constexpr int kDefaultMaxExemplarSize = 256;
 /// Largest output edge: solids (size^3 voxels) and images (pixels).
 constexpr int kMaxSolidSize = 2048;
+/// Upper ends of TextureOptimizationOptions::levels and ::iterations (check_options).
+constexpr int kMaxLevels = 8;
+constexpr int kMaxIterations = 100;
 /// Upper end of TextureOptimizationOptions::feature_threshold (in exemplar
 /// luminance standard deviations: no pixel is that far below its window's mean).
 constexpr double kMaxFeatureThreshold = 10.0;

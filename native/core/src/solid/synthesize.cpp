@@ -31,9 +31,9 @@ void check_options(const TextureOptimizationOptions& o) {
       throw InvalidInput(std::string(name) + " must be between " + std::to_string(lo).substr(0, 6) + " and " +
                          std::to_string(hi).substr(0, 8) + ", got " + std::to_string(v) + hint);
   };
-  range("levels", o.levels, 1, 8, "");
+  range("levels", o.levels, 1, kMaxLevels, "");
   range("neighborhood", o.neighborhood, 3, 32, " (the paper uses 8)");
-  range("iterations", o.iterations, 1, 100, "");
+  range("iterations", o.iterations, 1, kMaxIterations, "");
   range("finest_iterations", o.finest_iterations, -1, 100, " (0 = iterations, -1 = by size)");
   if (!(o.r > 0 && o.r <= 2)) throw InvalidInput("r must be in (0, 2], got " + std::to_string(o.r) + " (the paper uses 0.8)");
   if (!(o.pca_variance > 0 && o.pca_variance <= 1))
