@@ -894,7 +894,8 @@ def _add_surface_parser(sub):
     p.add_argument("--method", choices=surface_ops.METHODS, default="coherent", help="default coherent")
     size = p.add_mutually_exclusive_group()
     size.add_argument("--texels-per-unit", type=_finite, help="texels per unit of surface length")
-    size.add_argument("--face-resolution", type=_int, help="texels along every face map (default 16)")
+    size.add_argument("--face-resolution", type=_int, help="texels along every face map "
+                      f"(default {_native.SURFACE_DEFAULT_FACE_RESOLUTION})")
     p.add_argument("--exemplar-scale", type=_finite, default=1.0,
                    help="exemplar pixels per texel; larger makes the pattern smaller (default 1)")
     field = p.add_mutually_exclusive_group()
@@ -903,8 +904,8 @@ def _add_surface_parser(sub):
     field.add_argument("--field", help="(V, 3) .npy, a direction per vertex of --mesh (e.g. 'run field')")
     p.add_argument("--axis", type=_finite, nargs=3, metavar=("X", "Y", "Z"),
                    help="the presets' axis in the file's coordinates (default 0 0 1)")
-    p.add_argument("--segments", type=_int, default=2,
-                   help="limit-mesh quads along each n-gon sub-face, twice that per quad (default 2)")
+    p.add_argument("--segments", type=_int, default=_native.SURFACE_DEFAULT_SEGMENTS,
+                   help="limit-mesh quads along each n-gon sub-face, twice that per quad (default %(default)s)")
     p.add_argument("--height-scale", type=_finite,
                    help="with --height: displacement per unit of height around 0.5 (default 0.02)")
     p.add_argument("--out", required=True, help="the textured limit mesh: .obj (+ .mtl)")
@@ -936,7 +937,8 @@ def _run_surface(args):
     _require(args.face_resolution is None or args.face_resolution > 0,
              f"--face-resolution must be > 0 (got {args.face_resolution})")
     _require(args.exemplar_scale > 0, f"--exemplar-scale must be > 0 (got {args.exemplar_scale})")
-    _require(1 <= args.segments <= 32, f"--segments must be in 1..32 (got {args.segments})")
+    top = _native.SURFACE_MAX_SEGMENTS
+    _require(1 <= args.segments <= top, f"--segments must be in 1..{top} (got {args.segments})")
     if args.face_resolution is not None:
         top = _native.SURFACE_MAX_FACE_RESOLUTION
         _require(args.face_resolution <= top, f"--face-resolution must be in 1..{top} (got {args.face_resolution})")
@@ -961,7 +963,7 @@ def _run_surface(args):
     job = surface_ops.SurfaceJob(
         mesh=mesh, exemplar=exemplar, colour_channels=channels, has_height=height is not None,
         encoding=encoding, method=args.method, texels_per_unit=args.texels_per_unit or 0.0,
-        face_resolution=args.face_resolution or 16, exemplar_scale=args.exemplar_scale,
+        face_resolution=args.face_resolution or _native.SURFACE_DEFAULT_FACE_RESOLUTION, exemplar_scale=args.exemplar_scale,
         field_mode=args.field_preset, axis=tuple(args.axis), field=field, height_scale=args.height_scale,
         segments=args.segments, memory_budget=int(args.memory_budget * GIB), seed=args.seed,
     )

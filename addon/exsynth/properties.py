@@ -535,7 +535,7 @@ class ExSynthSettings(bpy.types.PropertyGroup):
     )
     surface_face_resolution: IntProperty(
         name="Face Resolution", description="Texels along each face map's side (an n-gon has n maps)",
-        default=16, min=2, max=512,
+        default=_native.SURFACE_DEFAULT_FACE_RESOLUTION, min=2, max=_native.SURFACE_MAX_FACE_RESOLUTION,
     )
     surface_exemplar_scale: FloatProperty(
         name="Exemplar Scale", description="Exemplar pixels per texel: larger makes the pattern smaller",
@@ -561,7 +561,7 @@ class ExSynthSettings(bpy.types.PropertyGroup):
         name="Mesh Detail",
         description="Quads along each n-gon sub-face of the result (quads get twice as many); the "
         "vertices of Blender's Subdivision level L are those of 2^(L-1)",
-        default=2, min=1, max=32,
+        default=_native.SURFACE_DEFAULT_SEGMENTS, min=1, max=_native.SURFACE_MAX_SEGMENTS, soft_max=32,
     )
 
     @property

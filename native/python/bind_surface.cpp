@@ -113,7 +113,7 @@ void set_options(SurfaceSynthesisOptions& o, SurfaceOutputOptions& out, const py
     } else if (k == "memory_budget") o.memory_budget = memory_budget_arg(v, k);
     else if (k == "seed") o.seed = seed_arg(v, k);
     else if (k == "gutter") out.gutter = int_arg(v, k, 0, 16, "texels");
-    else if (k == "segments") out.segments = int_arg(v, k, 1, 64, "per face");
+    else if (k == "segments") out.segments = int_arg(v, k, 1, kMaxSurfaceSegments, "per face");
     else if (k == "displacement_channel") out.displacement_channel = int_arg(v, k, -1, 15, "-1 = none");
     else if (k == "displacement_scale") out.displacement_scale = real_arg(v, k);
     else if (k == "displacement_midlevel") out.displacement_midlevel = real_arg(v, k);
@@ -133,6 +133,9 @@ py::array flatten(const std::vector<Eigen::Matrix<T, N, 1>>& v) {
 
 void bind_surface(py::module_& m) {
   m.attr("SURFACE_MAX_FACE_RESOLUTION") = SurfaceSynthesisOptions{}.max_face_resolution;
+  m.attr("SURFACE_DEFAULT_FACE_RESOLUTION") = SurfaceSynthesisOptions{}.face_resolution;
+  m.attr("SURFACE_DEFAULT_SEGMENTS") = SurfaceOutputOptions{}.segments;
+  m.attr("SURFACE_MAX_SEGMENTS") = kMaxSurfaceSegments;
   m.def(
       "texture_surface",
       [](const ArrayArg& vertices, const ArrayArg& face_sizes, const ArrayArg& face_vertices,

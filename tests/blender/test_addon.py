@@ -101,6 +101,13 @@ def test_defaults_and_limits_that_come_from_the_engine():
     assert rna["geo_dilation"].default == pytest.approx(_native.PAIR_DEFAULTS["dilation"])
     assert (rna["solid_bake_resolution"].default, rna["solid_bake_resolution"].hard_max) == (
         _native.BAKE_DEFAULT_SIZE, _native.BAKE_MAX_SIZE)
+    for name, default, hard in (("surface_segments", _native.SURFACE_DEFAULT_SEGMENTS, _native.SURFACE_MAX_SEGMENTS),
+                                ("surface_face_resolution", _native.SURFACE_DEFAULT_FACE_RESOLUTION,
+                                 _native.SURFACE_MAX_FACE_RESOLUTION)):
+        assert (rna[name].default, rna[name].hard_max) == (default, hard), name
+    surface = cli._parser().parse_args(["surface", "--mesh", "m.obj", "--exemplar", "e.png", "--out", "o.obj",
+                                        "--texture-out", "t.png"])
+    assert surface.segments == _native.SURFACE_DEFAULT_SEGMENTS
     # The CLI bakes at the same default size as the panel.
     help_text = cli._parser()._subparsers._group_actions[0].choices["solid"].format_help()
     assert f"(default {_native.BAKE_DEFAULT_SIZE})" in " ".join(help_text.split())

@@ -228,6 +228,9 @@ LimitMesh surface_limit_mesh(const SubdivSurface& surface, const SurfaceTexture&
                              int segments, int displacement_channel = -1, double displacement_scale = 0.0,
                              double displacement_midlevel = 0.5, ExecContext* ctx = nullptr);
 
+/// Upper end of surface_limit_mesh's segments (per n-gon sub-face).
+constexpr int kMaxSurfaceSegments = 64;
+
 // ---- the whole job ------------------------------------------------------------
 
 struct SurfaceOutputOptions {

@@ -128,7 +128,8 @@ LimitMesh surface_limit_mesh(const SubdivSurface& s, const SurfaceTexture& tex, 
                              int segments, int displacement_channel, double displacement_scale,
                              double displacement_midlevel, ExecContext* ctx) {
   check_texture(s, tex);
-  if (segments < 1 || segments > 64) throw InvalidInput("segments per face must be in [1, 64]");
+  if (segments < 1 || segments > kMaxSurfaceSegments)
+    throw InvalidInput("segments per face must be in [1, " + std::to_string(kMaxSurfaceSegments) + "]");
   if (displacement_channel >= tex.channels)
     throw InvalidInput("displacement channel " + std::to_string(displacement_channel) + " is not among the " +
                        std::to_string(tex.channels) + " channels");
