@@ -89,10 +89,12 @@ void bind_analogy(py::module_& m) {
         return out;
       },
       py::arg("a"), py::arg("a_prime"), py::arg("b"), py::kw_only(), py::arg("field_a") = py::none(),
-      py::arg("field_b") = py::none(), py::arg("voxel_size") = 1.0, py::arg("levels") = 2, py::arg("fine_size") = 5, py::arg("coarse_size") = 3, py::arg("sweeps") = 2,
-      py::arg("pca_variance") = 0.95, py::arg("max_pca_dims") = 24, py::arg("ann_eps") = 0.5, py::arg("coherence") = 1.0,
-      py::arg("coherence_slack") = 0.05,
-      py::arg("cull_distance") = -1.0, py::arg("remove_debris") = true,
+      py::arg("field_b") = py::none(), py::arg("voxel_size") = 1.0, py::arg("levels") = AnalogyOptions{}.levels,
+      py::arg("fine_size") = AnalogyOptions{}.fine_size, py::arg("coarse_size") = AnalogyOptions{}.coarse_size,
+      py::arg("sweeps") = AnalogyOptions{}.sweeps, py::arg("pca_variance") = AnalogyOptions{}.pca_variance,
+      py::arg("max_pca_dims") = AnalogyOptions{}.max_pca_dims, py::arg("ann_eps") = AnalogyOptions{}.ann_eps,
+      py::arg("coherence") = AnalogyOptions{}.coherence, py::arg("coherence_slack") = AnalogyOptions{}.coherence_slack,
+      py::arg("cull_distance") = AnalogyOptions{}.cull_distance, py::arg("remove_debris") = AnalogyOptions{}.remove_debris,
       py::arg("a_region") = py::none(), py::arg("memory_budget") = 0, py::arg("seed") = 0, py::arg("ctx") = py::none(),
       R"doc(Volume analogy B' : B :: A' : A (Bhat et al. 2004). a, a_prime: (Z, Y, X) float32 on one
 grid; b: (Z, Y, X) float32 on a grid of the same voxel_size (world units; used for automatic
