@@ -58,6 +58,11 @@ void apply_options(PairOptions& o, const py::kwargs& kw) {
 }  // namespace
 
 void bind_pairs(py::module_& m) {
+  {
+    py::list names;
+    for (PairPreset p : kPairPresets) names.append(pair_preset_name(p));
+    m.attr("PAIR_PRESETS") = py::tuple(names);
+  }
   m.attr("PAIR_MIN_RESOLUTION") = kMinPairResolution;
   m.attr("PAIR_MAX_RESOLUTION") = kMaxPairResolution;
   m.attr("PAIR_DETAIL_RESOLUTION") = kPairDetailResolution;

@@ -148,6 +148,11 @@ py::dict result_dict(PointTextureResult&& r) {
 }  // namespace
 
 void bind_points(py::module_& m) {
+  {
+    py::list names;
+    for (const char* name : kPointBuiltins) names.append(name);
+    m.attr("POINT_BUILTINS") = py::tuple(names);
+  }
   m.def(
       "point_texture_preset",
       [](const StrArg& name, const py::kwargs& extra) {

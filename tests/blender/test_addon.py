@@ -108,6 +108,9 @@ def test_defaults_and_limits_that_come_from_the_engine():
     surface = cli._parser().parse_args(["surface", "--mesh", "m.obj", "--exemplar", "e.png", "--out", "o.obj",
                                         "--texture-out", "t.png"])
     assert surface.segments == _native.SURFACE_DEFAULT_SEGMENTS
+    # The panels offer the engine's names, no more, no fewer.
+    assert tuple(i.identifier.lower() for i in rna["geo_preset"].enum_items) == _native.PAIR_PRESETS
+    assert tuple(i.identifier.lower() for i in rna["pts_preset"].enum_items) == _native.POINT_BUILTINS
     # The CLI bakes at the same default size as the panel.
     help_text = cli._parser()._subparsers._group_actions[0].choices["solid"].format_help()
     assert f"(default {_native.BAKE_DEFAULT_SIZE})" in " ".join(help_text.split())

@@ -30,7 +30,7 @@ from ..io.selection import select_only
 from ..jobs import InputError, Job, JobOperator
 from . import field as field_ops
 
-PRESETS = ("spikes", "pits", "holes", "grooves", "dilate")
+PRESETS = _native.PAIR_PRESETS  # spikes, pits, holes, grooves, dilate
 FIELD_PRESETS = tuple(field_ops.PRESETS.values())  # around_axis, along_axis, along_curve
 PAIR_MIN, PAIR_MAX = _native.PAIR_MIN_RESOLUTION, _native.PAIR_MAX_RESOLUTION  # make_exemplar_pair's range
 PATTERN_SCALE_MIN, PATTERN_SCALE_MAX = 0.05, 4.0  # the panel's Pattern Size range

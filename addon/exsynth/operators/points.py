@@ -25,7 +25,7 @@ from ..io.selection import select_only
 from ..jobs import InputError, Job, JobOperator
 from . import field as field_ops
 
-PRESETS = ("bumps", "chainmail", "weave", "flowers")
+PRESETS = _native.POINT_BUILTINS  # bumps, chainmail, weave, flowers
 USER_PADDING = 0.15  # a user exemplar's box: its points' bounds minus this fraction on every side
 MAX_POINTS = 20_000_000  # refuse outputs beyond this many points (estimated before running)
 

@@ -91,5 +91,8 @@ void validate_pair_options(PairPreset preset, const PairOptions& opt);
 
 /// "spikes", "pits", "holes", "grooves", "dilate".
 const char* pair_preset_name(PairPreset preset);
+/// Every preset, in the order above.
+constexpr PairPreset kPairPresets[] = {PairPreset::Spikes, PairPreset::Pits, PairPreset::Holes, PairPreset::Grooves,
+                                       PairPreset::Dilate};
 
 }  // namespace exsynth

@@ -86,6 +86,8 @@ struct PointTextureOptions {
 /// defaults. Throws InvalidInput for other names.
 PointTextureOptions point_texture_preset(const std::string& name);
 constexpr const char* kPointPresetNames = "default, heightfield, bumps, chainmail, weave or flowers";
+/// The built-in exemplars (make_point_exemplar's names).
+constexpr const char* kPointBuiltins[] = {"bumps", "chainmail", "weave", "flowers"};
 
 struct PointTextureTimes {
   double search = 0, warp = 0, blend = 0, other = 0;  ///< seconds, as the paper's Table 1
