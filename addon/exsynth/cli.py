@@ -30,7 +30,7 @@ from .operators.voxelize import VoxelizeJob
 from .properties import GIB
 
 MESH_FORMATS = (".obj", ".ply", ".stl")
-POINTS_DENSITY = 8000.0  # --density's default: the CLI's, lower than the engine's for quicker jobs
+POINTS_DENSITY = _native.POINTS_DEFAULT_DENSITY  # --density's default, as the panel's
 VOXEL_FORMATS = (".vdb", ".npy")
 
 

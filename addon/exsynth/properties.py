@@ -456,7 +456,7 @@ class ExSynthSettings(bpy.types.PropertyGroup):
     pts_file: StringProperty(name="File", description="A .ply with normals, .xyz or .pwn", subtype='FILE_PATH')
     pts_density: FloatProperty(
         name="Density", description="Points per unit of surface area of the exemplar (more: finer, slower)",
-        default=8000.0, min=10.0, soft_max=200000.0,
+        default=_native.POINTS_DEFAULT_DENSITY, min=10.0, soft_max=200000.0,
     )
     pts_output: EnumProperty(
         name="Output", description="Where the texture grows",

@@ -153,6 +153,7 @@ void bind_points(py::module_& m) {
     for (const char* name : kPointBuiltins) names.append(name);
     m.attr("POINT_BUILTINS") = py::tuple(names);
   }
+  m.attr("POINTS_DEFAULT_DENSITY") = kDefaultPointDensity;
   m.def(
       "point_texture_preset",
       [](const StrArg& name, const py::kwargs& extra) {

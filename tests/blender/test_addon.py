@@ -108,6 +108,7 @@ def test_defaults_and_limits_that_come_from_the_engine():
     surface = cli._parser().parse_args(["surface", "--mesh", "m.obj", "--exemplar", "e.png", "--out", "o.obj",
                                         "--texture-out", "t.png"])
     assert surface.segments == _native.SURFACE_DEFAULT_SEGMENTS
+    assert rna["pts_density"].default == _native.POINTS_DEFAULT_DENSITY == cli.POINTS_DENSITY
     # The panels offer the engine's names, no more, no fewer.
     assert tuple(i.identifier.lower() for i in rna["geo_preset"].enum_items) == _native.PAIR_PRESETS
     assert tuple(i.identifier.lower() for i in rna["pts_preset"].enum_items) == _native.POINT_BUILTINS

@@ -36,7 +36,7 @@ class Exemplar:
 
     name: str
     preset: str = None          # built-in
-    density: float = 20000.0    # built-ins and meshes: points per unit area
+    density: float = _native.POINTS_DEFAULT_DENSITY  # built-ins and meshes: points per unit area
     vertices: np.ndarray = None  # a mesh to sample (V by 3) ...
     triangles: np.ndarray = None  # ... and its faces (F by 3)
     positions: np.ndarray = None  # given points (N by 3) ...

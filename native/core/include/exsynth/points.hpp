@@ -86,6 +86,9 @@ struct PointTextureOptions {
 /// defaults. Throws InvalidInput for other names.
 PointTextureOptions point_texture_preset(const std::string& name);
 constexpr const char* kPointPresetNames = "default, heightfield, bumps, chainmail, weave or flowers";
+/// The exemplar density the add-on and the CLI start from (points per unit of
+/// surface area of a built-in or sampled exemplar).
+constexpr double kDefaultPointDensity = 8000.0;
 /// The built-in exemplars (make_point_exemplar's names).
 constexpr const char* kPointBuiltins[] = {"bumps", "chainmail", "weave", "flowers"};
 
