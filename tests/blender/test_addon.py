@@ -3,6 +3,7 @@
 
 import os
 import subprocess
+import types
 
 import addon_utils
 import bpy
@@ -20,6 +21,8 @@ def test_operator_panel_and_settings_are_registered():
     panel = bpy.types.EXSYNTH_PT_voxelize
     assert (panel.bl_space_type, panel.bl_region_type, panel.bl_category) == ('VIEW_3D', 'UI', "ExSynth")
     assert bpy.types.EXSYNTH_PT_voxelize_advanced.bl_parent_id == "EXSYNTH_PT_voxelize"
+    # Surface Texture's job takes a seed and a memory budget: its Advanced panel shows them.
+    assert bpy.types.EXSYNTH_PT_surface_advanced.bl_parent_id == "EXSYNTH_PT_surface"
 
     settings = bpy.context.scene.exsynth
     assert settings.resolution == 128 and settings.make_mesh is True
@@ -116,3 +119,19 @@ def test_defaults_and_limits_that_come_from_the_engine():
     help_text = cli._parser()._subparsers._group_actions[0].choices["solid"].format_help()
     assert f"(default {_native.BAKE_DEFAULT_SIZE})" in " ".join(help_text.split())
     assert f"the engine's {_native.DEFAULT_MEMORY_BUDGET / 2 ** 30:g} GiB" in " ".join(help_text.split())
+
+
+def test_the_surface_advanced_panel_draws_the_seed_and_the_memory_budget():
+    drawn = []
+
+    class Layout:
+        def prop(self, _data, name, **_):
+            drawn.append(name)
+
+        def __getattr__(self, name):
+            return lambda *a, **k: self
+
+    layout = Layout()
+    bpy.types.EXSYNTH_PT_surface_advanced.draw(types.SimpleNamespace(layout=layout, _layout=lambda: layout),
+                                               bpy.context)
+    assert drawn == ["seed", "memory_budget_gib"]

@@ -3,7 +3,7 @@
 
 import bpy
 
-from .main import SidebarPanel
+from .main import SidebarPanel, draw_shared_advanced
 
 
 class EXSYNTH_PT_surface(SidebarPanel, bpy.types.Panel):
@@ -37,4 +37,15 @@ class EXSYNTH_PT_surface(SidebarPanel, bpy.types.Panel):
         row.operator("exsynth.surface_texture", icon='TEXTURE')
 
 
-CLASSES = (EXSYNTH_PT_surface,)
+class EXSYNTH_PT_surface_advanced(SidebarPanel, bpy.types.Panel):
+    """The seed and memory budget the Surface Texture job uses."""
+
+    bl_label = "Advanced"
+    bl_parent_id = "EXSYNTH_PT_surface"
+    bl_options = {'DEFAULT_CLOSED'}
+
+    def draw(self, context):
+        draw_shared_advanced(self._layout(), context.scene.exsynth)
+
+
+CLASSES = (EXSYNTH_PT_surface, EXSYNTH_PT_surface_advanced)
