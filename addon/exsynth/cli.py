@@ -416,17 +416,15 @@ def _run_analogy(args):
             raise UsageError(f"--b: {exc} (--pattern-size)")
         print(f"exsynth analogy: pattern size {pattern_scale:.3g} of B's longest side, fitted to its "
               f"thickness {measure['thickness']:.4g}", file=sys.stderr)
-    fitted = bool(args.preset) and args.pattern_size is None
-    resolution = analogy_ops.grid_resolution(args.resolution, pattern_scale, fitted) if args.preset else args.resolution
     job = analogy_ops.GeometricTextureJob(
-        b=b, preset=args.preset or "spikes", resolution=resolution,
+        b=b, preset=args.preset or "spikes", resolution=args.resolution,
         pattern_scale=0.5 if pattern_scale is None else pattern_scale,
-        pair_options=_pair_options(args),
-        memory_budget=int(args.memory_budget * GIB), asked_resolution=args.resolution,
+        fit_pattern=bool(args.preset) and args.pattern_size is None, pair_options=_pair_options(args),
+        memory_budget=int(args.memory_budget * GIB),
     )
-    if resolution > args.resolution:
-        print(f"exsynth analogy: resolution {resolution} (--resolution {args.resolution} raised so that the pair has "
-              f"{job.pair_resolution} voxels across, which its features need)", file=sys.stderr)
+    if job.grid_resolution > args.resolution:
+        print(f"exsynth analogy: resolution {job.grid_resolution} (--resolution {args.resolution} raised so that the "
+              f"pair has {job.pair_resolution} voxels across, which its features need)", file=sys.stderr)
     elif args.preset and job.pair_resolution < _native.PAIR_DETAIL_RESOLUTION:
         print(f"exsynth analogy: the pair has {job.pair_resolution} voxels across; its features come out soft "
               f"under {_native.PAIR_DETAIL_RESOLUTION} (raise --resolution or --pattern-size, or leave "

@@ -20,11 +20,8 @@ constexpr const char* kOptionNames =
 constexpr const char* kPresetNames = "'spikes', 'pits', 'holes', 'grooves' or 'dilate'";
 
 PairPreset to_preset(const std::string& s) {
-  if (s == "spikes") return PairPreset::Spikes;
-  if (s == "pits") return PairPreset::Pits;
-  if (s == "holes") return PairPreset::Holes;
-  if (s == "grooves") return PairPreset::Grooves;
-  if (s == "dilate") return PairPreset::Dilate;
+  for (PairPreset p : kPairPresets)
+    if (s == pair_preset_name(p)) return p;
   throw InvalidInput("preset must be 'spikes', 'pits', 'holes', 'grooves' or 'dilate', got '" + s + "'");
 }
 

@@ -173,11 +173,11 @@ class GeometricTextureJob(Job):
     preset: str = "spikes"  # the built-in pair, unless a and a_prime are given
     a: MeshInput = None
     a_prime: MeshInput = None
-    resolution: int = 64
+    resolution: int = 64  # the user's; see grid_resolution
     pattern_scale: float = 0.5  # built-in pairs only
+    fit_pattern: bool = False  # pattern_scale was fitted to B: the grid follows it (grid_resolution)
     pair_options: dict = dataclasses.field(default_factory=dict)
     memory_budget: int = 0  # bytes; 0 = the engine's default
-    asked_resolution: int = 0  # the user's Resolution, when a fitted pattern raised it (grid_resolution)
 
     label = "geometric texture"
 
@@ -186,8 +186,13 @@ class GeometricTextureJob(Job):
         return self.a is not None
 
     @property
+    def grid_resolution(self):
+        """B's voxels along its longest side: the Resolution, raised for a fitted built-in pattern."""
+        return grid_resolution(self.resolution, self.pattern_scale, self.fit_pattern and not self.user_pair)
+
+    @property
     def pair_resolution(self):
-        return pair_resolution(self.resolution, self.pattern_scale)
+        return pair_resolution(self.grid_resolution, self.pattern_scale)
 
     @property
     def pair_name(self):
@@ -201,7 +206,7 @@ class GeometricTextureJob(Job):
         return int(math.ceil(growth * self.pair_resolution / 2.0)) + _native.analogy_padding()
 
     def run(self, ctx):
-        h = voxel_size_for(self.b.vertices, self.resolution)
+        h = voxel_size_for(self.b.vertices, self.grid_resolution)
         common = dict(supersample=2, compute_sdf=True, memory_budget=self.memory_budget, ctx=ctx)
         if self.user_pair:
             a, a_prime, field_a, growth, region = self._user_pair(h, common, ctx)
@@ -211,11 +216,10 @@ class GeometricTextureJob(Job):
             padding = self.padding()
             region = None
         self.share(ctx, 0.15, 0.22)
-        fix = "lower the resolution"
-        if self.resolution > self.asked_resolution:
-            fix = (f"set a larger Pattern Size by hand (the fitted one raised the resolution from "
-                   f"{self.asked_resolution} to {self.resolution} for its detail)")
-        grid = _voxelize("B", self.b.vertices, self.b.triangles, fix=fix, voxel_size=h, padding=padding, **common)
+        raised = self.grid_resolution > self.resolution
+        fix = {"fix": f"set a larger Pattern Size by hand (the fitted one raised the resolution from "
+                      f"{self.resolution} to {self.grid_resolution} for its detail)"} if raised else {}
+        grid = _voxelize("B", self.b.vertices, self.b.triangles, voxel_size=h, padding=padding, **fix, **common)
         b, origin = grid["sdf"], grid["origin"]
         field_b = self.b.field.frames_t(self.b, grid, ctx, span=(0.22, 0.27))
         if not self.user_pair:
@@ -540,10 +544,9 @@ class EXSYNTH_OT_geometric_texture(JobOperator, bpy.types.Operator):
         if fit:  # the value the panel shows (ui/pattern_preview.py measures the same mesh)
             scale, _ = fitted_pattern_scale(b.vertices, b.triangles, settings.geo_resolution)
         job = GeometricTextureJob(
-            b=b, preset=settings.geo_preset.lower(),
-            resolution=grid_resolution(settings.geo_resolution, scale, fit) if builtin else settings.geo_resolution,
-            pattern_scale=scale, pair_options=pair_options(settings),
-            memory_budget=settings.memory_budget_bytes, asked_resolution=settings.geo_resolution,
+            b=b, preset=settings.geo_preset.lower(), resolution=settings.geo_resolution,
+            pattern_scale=scale, fit_pattern=fit, pair_options=pair_options(settings),
+            memory_budget=settings.memory_budget_bytes,
         )
         if settings.geo_pair_source == 'OBJECTS':
             job.a, job.a_prime = user_pair(context, settings, b)
